@@ -1,0 +1,44 @@
+//! The MERL sampling grid: the angles at which each cell is sampled, and which cells lie above
+//! the horizon. Angles follow the conventions of the NBRDF tabulation (cell lower edges):
+//! theta_h = (i / 90)^2 * pi/2 (MERL's square-root warp), theta_d = j / 90 * pi/2,
+//! phi_d = k / 180 * pi.
+
+use super::table::{N_PHI_D, N_THETA_D, N_THETA_H};
+use std::f64::consts::{FRAC_PI_2, PI};
+
+/// theta_h (radians) of index `i`: the inverse of MERL's square-root warp.
+#[inline]
+pub fn theta_h_of(i: usize) -> f64 {
+    let u = i as f64 / N_THETA_H as f64;
+    u * u * FRAC_PI_2
+}
+
+/// theta_d (radians) of index `j`.
+#[inline]
+pub fn theta_d_of(j: usize) -> f64 {
+    j as f64 / N_THETA_D as f64 * FRAC_PI_2
+}
+
+/// phi_d (radians) of index `k`, in [0, pi).
+#[inline]
+pub fn phi_d_of(k: usize) -> f64 {
+    k as f64 / N_PHI_D as f64 * PI
+}
+
+/// Whether both directions of a cell lie strictly above the horizon.
+///
+/// With the half vector at (theta_h, phi_h = 0) and the difference vector at (theta_d, phi_d),
+/// Rusinkiewicz 2001 gives `cos theta_{i,o} = cos td cos th -/+ sin td cos pd sin th`;
+/// the cell is valid when the smaller of the two is positive.
+#[inline]
+pub fn angles_are_valid(theta_h: f64, theta_d: f64, phi_d: f64) -> bool {
+    let a = theta_d.cos() * theta_h.cos();
+    let b = theta_d.sin() * phi_d.cos().abs() * theta_h.sin();
+    a - b > 0.0
+}
+
+/// Whether the cell with indices (i, j, k) lies above the horizon at its sample angles.
+#[inline]
+pub fn cell_is_valid(i: usize, j: usize, k: usize) -> bool {
+    angles_are_valid(theta_h_of(i), theta_d_of(j), phi_d_of(k))
+}

@@ -1,0 +1,78 @@
+//! Run-time choice of the compute device among the backends compiled in (cargo features
+//! `flex` (default), `ndarray`, `wgpu`, `cuda`).
+
+use std::fmt;
+use std::str::FromStr;
+
+/// A backend this binary can run on, chosen with `--device`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DeviceKind {
+    /// burn-flex, the fast portable CPU backend (the default).
+    Flex,
+    /// burn-ndarray, the legacy CPU backend.
+    Ndarray,
+    /// wgpu (WGSL), any GPU with Vulkan, Metal or DX12.
+    Wgpu,
+    /// CUDA, NVIDIA GPUs.
+    Cuda,
+}
+
+impl DeviceKind {
+    /// Every kind, compiled in or not.
+    pub const ALL: [DeviceKind; 4] =
+        [DeviceKind::Flex, DeviceKind::Ndarray, DeviceKind::Wgpu, DeviceKind::Cuda];
+
+    /// Whether this binary was built with the kind's cargo feature.
+    pub fn is_compiled(self) -> bool {
+        match self {
+            DeviceKind::Flex => cfg!(feature = "flex"),
+            DeviceKind::Ndarray => cfg!(feature = "ndarray"),
+            DeviceKind::Wgpu => cfg!(feature = "wgpu"),
+            DeviceKind::Cuda => cfg!(feature = "cuda"),
+        }
+    }
+
+    /// The kinds compiled into this binary, the default first.
+    pub fn available() -> Vec<DeviceKind> {
+        Self::ALL.into_iter().filter(|k| k.is_compiled()).collect()
+    }
+
+    /// The cargo feature (and `--device` name) of this kind.
+    pub fn name(self) -> &'static str {
+        match self {
+            DeviceKind::Flex => "flex",
+            DeviceKind::Ndarray => "ndarray",
+            DeviceKind::Wgpu => "wgpu",
+            DeviceKind::Cuda => "cuda",
+        }
+    }
+}
+
+impl fmt::Display for DeviceKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for DeviceKind {
+    type Err = String;
+
+    /// Parses a device name; refuses kinds not compiled in, naming the feature to build with.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let kind = Self::ALL
+            .into_iter()
+            .find(|k| k.name().eq_ignore_ascii_case(s.trim()))
+            .ok_or_else(|| {
+                format!("unknown device '{s}': expected one of flex, ndarray, wgpu, cuda")
+            })?;
+        if !kind.is_compiled() {
+            let have: Vec<_> = Self::available().iter().map(|k| k.name()).collect();
+            return Err(format!(
+                "device '{kind}' is not compiled into this binary (rebuild with `--features {kind}`); available: {}",
+                have.join(", ")
+            ));
+        }
+        Ok(kind)
+    }
+}

@@ -1,0 +1,20 @@
+//! Command-line definition. Each subcommand's arguments live in its own file under `commands/`.
+use crate::commands;
+use clap::{Parser, Subcommand};
+
+/// DeepBRDF: a deep, compact and editable representation of measured BRDFs (Hu et al., CGF 2020).
+#[derive(Debug, Parser)]
+#[command(name = "experiments", version, about)]
+pub struct Cli {
+    /// Show no progress bars.
+    #[arg(long, short, global = true)]
+    pub quiet: bool,
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// List the compute devices compiled into this binary.
+    Devices(commands::devices::Args),
+}

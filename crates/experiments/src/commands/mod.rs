@@ -1,0 +1,12 @@
+//! One file per subcommand; `run` dispatches.
+use crate::cli::{Cli, Command};
+use crate::progress::Bars;
+
+pub mod devices;
+
+pub fn run(cli: Cli) -> anyhow::Result<()> {
+    let progress = Bars::new(cli.quiet);
+    match cli.command {
+        Command::Devices(args) => devices::run(args, &progress),
+    }
+}

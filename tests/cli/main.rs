@@ -1,0 +1,4 @@
+//! End-to-end tests of the `experiments` command line, compiled as one test binary.
+mod util;
+
+mod devices;

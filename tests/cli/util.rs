@@ -1,0 +1,38 @@
+//! Shared helpers for CLI tests: run the binary, temporary directories.
+#![allow(dead_code)]
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// Runs `experiments` with `args` in `cwd` (quiet), returning its output.
+pub fn run_in(cwd: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_experiments"))
+        .args(args)
+        .arg("--quiet")
+        .current_dir(cwd)
+        .output()
+        .expect("failed to spawn the experiments binary")
+}
+
+/// Runs `experiments` with `args` in a fresh temporary directory.
+pub fn run(args: &[&str]) -> Output {
+    let dir = tempfile::tempdir().expect("tempdir");
+    run_in(dir.path(), args)
+}
+
+pub fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Asserts a run failed cleanly: non-zero exit, an `error:` line, and no panic.
+pub fn assert_clean_failure(o: &Output, needle: &str) {
+    let err = stderr(o);
+    assert!(!o.status.success(), "expected failure, got success; stderr: {err}");
+    assert!(!err.contains("panicked"), "the binary panicked: {err}");
+    assert!(err.contains("error:"), "no error line: {err}");
+    assert!(err.contains(needle), "error does not mention '{needle}': {err}");
+}
