@@ -1,1 +1,13 @@
-//! placeholder
+//! `deepbrdf-eval`: evaluation of measured-BRDF representations (Hu et al., CGF 2020, §4):
+//! the PCA and IPCA baselines, the evaluation harness shared with DeepBRDF, and figures.
+pub mod baseline;
+pub mod error;
+pub mod figures;
+pub mod harness;
+pub mod ipca;
+mod median_reference;
+#[cfg(test)]
+mod testing;
+pub mod pca;
+
+pub use error::{EvalError, Result};

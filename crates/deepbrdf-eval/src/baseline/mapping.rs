@@ -1,0 +1,146 @@
+//! The value mapping applied before PCA: the logarithm of traditional PCA, or IPCA's
+//! cosine-weighted log-relative mapping (Nielsen et al. 2015). Rows are in [`Domain`] order.
+
+use super::domain::Domain;
+use crate::error::{EvalError, Result};
+use crate::{ipca, pca};
+use deepbrdf_data::merl::{CELLS, INVALID_VALUE, VALUES};
+use deepbrdf_data::MerlTable;
+use rayon::prelude::*;
+
+/// Which mapping a baseline uses, before fitting (IPCA's reference comes from the training set).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MappingKind {
+    /// `ln(rho + LOG_EPSILON)`: traditional PCA.
+    Log,
+    /// `ln((rho cos_i cos_o + eps) / (rho_ref cos_i cos_o + eps))`: IPCA.
+    LogRelative,
+}
+
+/// A fitted mapping.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Mapping {
+    /// Traditional PCA's logarithm ([`pca::log_map`]).
+    Log,
+    /// IPCA's log-relative mapping ([`ipca::log_relative`]).
+    LogRelative {
+        /// rho_ref in row order (the per-value median of the training tables).
+        reference: Vec<f32>,
+        /// cos(theta_i) cos(theta_o) of each domain cell.
+        cos_weight: Vec<f32>,
+    },
+}
+
+impl Mapping {
+    /// The kind of a PCA baseline's mapping.
+    pub fn log_kind() -> MappingKind {
+        MappingKind::Log
+    }
+
+    /// This mapping's kind.
+    pub fn kind(&self) -> MappingKind {
+        match self {
+            Self::Log => MappingKind::Log,
+            Self::LogRelative { .. } => MappingKind::LogRelative,
+        }
+    }
+
+    /// IPCA's mapping over `domain`, with `reference` the full-table (VALUES long) median.
+    pub fn log_relative(domain: &Domain, reference: &[f32]) -> Result<Self> {
+        if reference.len() != VALUES {
+            return Err(EvalError::Invalid(format!(
+                "a reference table has {VALUES} values, got {}",
+                reference.len()
+            )));
+        }
+        let n = domain.cells().len();
+        let mut row = vec![0f32; domain.dim()];
+        for c in 0..3 {
+            for (m, &cell) in domain.cells().iter().enumerate() {
+                row[domain.row_index(c, m)] = reference[c * CELLS + cell as usize];
+            }
+        }
+        let cos_weight = domain.cells().iter().map(|&c| ipca::cos_product(c as usize) as f32).collect::<Vec<_>>();
+        debug_assert_eq!(cos_weight.len(), n);
+        Self::log_relative_from_parts(domain, row, cos_weight)
+    }
+
+    /// IPCA's mapping from a row-ordered reference and per-cell weights (an artifact).
+    pub fn log_relative_from_parts(domain: &Domain, reference: Vec<f32>, cos_weight: Vec<f32>) -> Result<Self> {
+        if reference.len() != domain.dim() || cos_weight.len() != domain.cells().len() {
+            return Err(EvalError::Invalid("IPCA reference does not match its domain".into()));
+        }
+        if let Some(i) = reference.iter().position(|r| !(r.is_finite() && *r >= 0.0)) {
+            return Err(EvalError::Invalid(format!("IPCA reference value {i} is {}", reference[i])));
+        }
+        if cos_weight.iter().any(|w| !(w.is_finite() && *w > 0.0)) {
+            return Err(EvalError::Invalid("IPCA cosine weight not positive on the domain".into()));
+        }
+        Ok(Self::LogRelative { reference, cos_weight })
+    }
+
+    /// Maps `table` to a row over `domain`. A domain cell that is invalid in `table` gets NaN
+    /// (the codec replaces it with the basis mean).
+    pub fn forward(&self, domain: &Domain, table: &MerlTable) -> Vec<f32> {
+        let n = domain.cells().len();
+        let values = table.values();
+        let mut row = vec![0f32; domain.dim()];
+        row.par_chunks_mut(n).enumerate().for_each(|(c, out)| {
+            for (m, (o, &cell)) in out.iter_mut().zip(domain.cells()).enumerate() {
+                let cell = cell as usize;
+                if !table.is_valid(cell) {
+                    *o = f32::NAN;
+                    continue;
+                }
+                let rho = f64::from(values[c * CELLS + cell]);
+                *o = match self {
+                    Self::Log => pca::log_map(rho),
+                    Self::LogRelative { reference, cos_weight } => ipca::log_relative(
+                        rho,
+                        f64::from(reference[c * n + m]),
+                        f64::from(cos_weight[m]),
+                    ),
+                } as f32;
+            }
+        });
+        row
+    }
+
+    /// Inverse of [`Mapping::forward`]: a full table, valid exactly on `domain`, reflectance
+    /// clamped to `[0, f32::MAX]` (a truncated basis can decode below zero).
+    pub fn inverse(&self, domain: &Domain, row: &[f32]) -> Result<MerlTable> {
+        if row.len() != domain.dim() {
+            return Err(EvalError::Invalid(format!(
+                "row of length {} for a domain of {} values",
+                row.len(),
+                domain.dim()
+            )));
+        }
+        let n = domain.cells().len();
+        let mut values = vec![INVALID_VALUE; VALUES];
+        values.par_chunks_mut(CELLS).enumerate().for_each(|(c, out)| {
+            for (m, &cell) in domain.cells().iter().enumerate() {
+                let y = f64::from(row[c * n + m]);
+                let rho = match self {
+                    Self::Log => pca::log_unmap(y),
+                    Self::LogRelative { reference, cos_weight } => ipca::log_relative_inverse(
+                        y,
+                        f64::from(reference[c * n + m]),
+                        f64::from(cos_weight[m]),
+                    ),
+                };
+                out[cell as usize] = clamp_reflectance(rho);
+            }
+        });
+        Ok(MerlTable::from_values(values)?)
+    }
+}
+
+/// A decoded reflectance as a valid table value: NaN and negatives to 0, overflow to f32::MAX.
+fn clamp_reflectance(rho: f64) -> f32 {
+    if rho.is_nan() || rho <= 0.0 {
+        0.0
+    } else {
+        rho.min(f64::from(f32::MAX)) as f32
+    }
+}

@@ -1,0 +1,316 @@
+//! The PCA and IPCA baselines on MERL tables: a [`Mapping`] of the valid cells ([`Domain`])
+//! followed by a [`LinearBasis`] (eq. 5), as a harness [`Method`] / [`Codec`].
+
+mod artifact;
+mod domain;
+mod mapping;
+
+pub use domain::Domain;
+pub use mapping::{Mapping, MappingKind};
+
+use crate::error::{EvalError, Result};
+use crate::harness::{Codec, Method};
+use crate::pca::LinearBasis;
+use deepbrdf_data::{MerlTable, Progress};
+use std::path::Path;
+use std::sync::Arc;
+
+/// A fitted baseline: domain, mapping and linear basis. Codecs of any `k <= basis.k()` share it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BaselineBasis {
+    name: String,
+    domain: Domain,
+    mapping: Mapping,
+    basis: LinearBasis,
+    n_train: usize,
+}
+
+impl BaselineBasis {
+    /// Fits `kind`'s mapping and `k` components to `train`.
+    pub fn fit(
+        name: &str,
+        kind: MappingKind,
+        train: &[&MerlTable],
+        k: usize,
+        progress: &dyn Progress,
+    ) -> Result<Self> {
+        if train.len() < 2 {
+            return Err(EvalError::Invalid(format!(
+                "{name} needs at least 2 training tables, got {}",
+                train.len()
+            )));
+        }
+        let domain = Domain::common(train)?;
+        let mapping = match kind {
+            MappingKind::Log => Mapping::Log,
+            MappingKind::LogRelative => {
+                let median = crate::median_reference::MedianReference::from_tables(train)?;
+                Mapping::log_relative(&domain, median.values())?
+            }
+        };
+        let rows: Vec<Vec<f32>> = train.iter().map(|t| mapping.forward(&domain, t)).collect();
+        let refs: Vec<&[f32]> = rows.iter().map(|r| r.as_slice()).collect();
+        let basis = LinearBasis::fit(&refs, k, progress)?;
+        Ok(Self { name: name.to_string(), domain, mapping, basis, n_train: train.len() })
+    }
+
+    /// The method's name ("PCA", "IPCA").
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The cells covered.
+    pub fn domain(&self) -> &Domain {
+        &self.domain
+    }
+
+    /// The value mapping.
+    pub fn mapping(&self) -> &Mapping {
+        &self.mapping
+    }
+
+    /// The linear basis in mapped space.
+    pub fn basis(&self) -> &LinearBasis {
+        &self.basis
+    }
+
+    /// Number of training tables.
+    pub fn n_train(&self) -> usize {
+        self.n_train
+    }
+
+    /// `k` coefficients of `table`. Domain cells invalid in `table` are taken at the mean.
+    pub fn encode(&self, table: &MerlTable, k: usize) -> Result<Vec<f32>> {
+        let mut row = self.mapping.forward(&self.domain, table);
+        for (x, &m) in row.iter_mut().zip(self.basis.mean()) {
+            if x.is_nan() {
+                *x = m;
+            }
+        }
+        self.basis.encode(&row, k)
+    }
+
+    /// The table of coefficients `code` (`code.len()` components used).
+    pub fn decode(&self, code: &[f32]) -> Result<MerlTable> {
+        if let Some(i) = code.iter().position(|c| !c.is_finite()) {
+            return Err(EvalError::Invalid(format!("coefficient {i} is {}", code[i])));
+        }
+        let row = self.basis.decode(code)?;
+        self.mapping.inverse(&self.domain, &row)
+    }
+
+    /// Writes the basis as an artifact file (atomic: temp file, then rename).
+    pub fn save(&self, path: &Path) -> Result<()> {
+        artifact::save(self, path)
+    }
+
+    /// Reads an artifact written by [`BaselineBasis::save`], checking its header and checksum.
+    pub fn load(path: &Path) -> Result<Self> {
+        artifact::load(path)
+    }
+
+    /// A codec using the first `k` components.
+    pub fn codec(self: &Arc<Self>, k: usize) -> Result<BaselineCodec> {
+        if k == 0 || k > self.basis.k() {
+            return Err(EvalError::Invalid(format!(
+                "k = {k} from a {} basis of {} components",
+                self.name,
+                self.basis.k()
+            )));
+        }
+        Ok(BaselineCodec { basis: Arc::clone(self), k })
+    }
+}
+
+/// A [`BaselineBasis`] truncated to `k` components.
+#[derive(Clone, Debug)]
+pub struct BaselineCodec {
+    basis: Arc<BaselineBasis>,
+    k: usize,
+}
+
+impl BaselineCodec {
+    /// The shared fitted basis.
+    pub fn basis(&self) -> &Arc<BaselineBasis> {
+        &self.basis
+    }
+}
+
+impl Codec for BaselineCodec {
+    fn name(&self) -> String {
+        format!("{}-{}", self.basis.name, self.k)
+    }
+
+    fn k(&self) -> usize {
+        self.k
+    }
+
+    fn encode(&self, table: &MerlTable) -> Result<Vec<f32>> {
+        self.basis.encode(table, self.k)
+    }
+
+    fn decode(&self, code: &[f32]) -> Result<MerlTable> {
+        if code.len() != self.k {
+            return Err(EvalError::Invalid(format!(
+                "{} expects {} coefficients, got {}",
+                self.name(),
+                self.k,
+                code.len()
+            )));
+        }
+        self.basis.decode(code)
+    }
+}
+
+/// PCA or IPCA as a harness [`Method`] (see [`crate::pca::Pca::method`], [`crate::ipca::Ipca::method`]).
+#[derive(Clone, Debug)]
+pub struct BaselineMethod {
+    name: String,
+    kind: MappingKind,
+}
+
+impl BaselineMethod {
+    /// A baseline named `name` with mapping `kind`.
+    pub fn new(name: &str, kind: MappingKind) -> Self {
+        Self { name: name.to_string(), kind }
+    }
+
+    /// Fits one basis of `k` components.
+    pub fn fit_basis(&self, train: &[&MerlTable], k: usize, progress: &dyn Progress) -> Result<BaselineBasis> {
+        BaselineBasis::fit(&self.name, self.kind, train, k, progress)
+    }
+}
+
+impl Method for BaselineMethod {
+    fn name(&self) -> String {
+        self.name.clone()
+    }
+
+    fn fit(
+        &self,
+        train: &[&MerlTable],
+        _names: &[String],
+        k: usize,
+        progress: &dyn Progress,
+    ) -> Result<Box<dyn Codec>> {
+        let basis = Arc::new(self.fit_basis(train, k, progress)?);
+        Ok(Box::new(basis.codec(k)?))
+    }
+
+    /// One fit at the largest k; every codec is a truncation of it (PCA components are nested).
+    fn fit_ks(
+        &self,
+        train: &[&MerlTable],
+        _names: &[String],
+        ks: &[usize],
+        progress: &dyn Progress,
+    ) -> Result<Vec<Box<dyn Codec>>> {
+        let k_max = ks.iter().copied().max().ok_or_else(|| EvalError::Invalid("no k given".into()))?;
+        let basis = Arc::new(self.fit_basis(train, k_max, progress)?);
+        ks.iter().map(|&k| Ok(Box::new(basis.codec(k)?) as Box<dyn Codec>)).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::synthetic_set;
+    use deepbrdf_data::merl::CELLS;
+    use deepbrdf_data::Silent;
+
+    /// Largest |rho - rho_hat| cos_i cos_o over the domain.
+    fn max_weighted_error(a: &MerlTable, b: &MerlTable, domain: &Domain) -> f64 {
+        let mut worst = 0f64;
+        for &cell in domain.cells() {
+            let w = crate::ipca::cos_product(cell as usize);
+            for c in 0..3 {
+                let i = c * CELLS + cell as usize;
+                worst = worst.max((f64::from(a.values()[i]) - f64::from(b.values()[i])).abs() * w);
+            }
+        }
+        worst
+    }
+
+    #[test]
+    fn mappings_round_trip_on_tables() {
+        let (_, tables) = synthetic_set(3);
+        let refs: Vec<&MerlTable> = tables.iter().collect();
+        let domain = Domain::common(&refs).unwrap();
+        assert_eq!(domain.cells().len(), tables[0].valid_cells());
+        let median = crate::median_reference::MedianReference::from_tables(&refs).unwrap();
+        for mapping in [Mapping::Log, Mapping::log_relative(&domain, median.values()).unwrap()] {
+            let back = mapping.inverse(&domain, &mapping.forward(&domain, &tables[2])).unwrap();
+            assert_eq!(back.mask(), tables[2].mask());
+            for &cell in domain.cells().iter().step_by(101) {
+                for c in 0..3 {
+                    let i = c * CELLS + cell as usize;
+                    let (x, y) = (tables[2].values()[i], back.values()[i]);
+                    assert!((x - y).abs() <= 1e-5 * (1.0 + x.abs()), "{mapping:?}: {x} vs {y}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn full_rank_codecs_reproduce_their_training_tables() {
+        let (names, tables) = synthetic_set(5);
+        let refs: Vec<&MerlTable> = tables.iter().collect();
+        for method in [crate::pca::Pca::method(), crate::ipca::Ipca::method()] {
+            let codecs = method.fit_ks(&refs, &names, &[1, 4], &Silent).unwrap();
+            assert_eq!(codecs[1].name(), format!("{}-4", method.name()));
+            let domain = Domain::common(&refs).unwrap();
+            for t in &tables {
+                let full = codecs[1].decode(&codecs[1].encode(t).unwrap()).unwrap();
+                let err = max_weighted_error(t, &full, &domain);
+                assert!(err < 2e-4, "{}: k = n-1 error {err}", method.name());
+                let one = codecs[0].decode(&codecs[0].encode(t).unwrap()).unwrap();
+                assert!(max_weighted_error(t, &one, &domain) > 1e-3);
+            }
+            assert!(codecs[0].decode(&[0.0, 0.0]).is_err());
+            assert!(codecs[0].decode(&[f32::NAN]).is_err());
+        }
+    }
+
+    #[test]
+    fn artifact_round_trips_and_rejects_corruption() {
+        let (_, tables) = synthetic_set(4);
+        let refs: Vec<&MerlTable> = tables.iter().collect();
+        let dir = tempfile::tempdir().unwrap();
+        for method in [crate::pca::Pca::method(), crate::ipca::Ipca::method()] {
+            let basis = method.fit_basis(&refs, 2, &Silent).unwrap();
+            let path = dir.path().join(format!("{}.basis", method.name()));
+            basis.save(&path).unwrap();
+            let back = BaselineBasis::load(&path).unwrap();
+            assert_eq!(back, basis);
+            let code = basis.encode(&tables[1], 2).unwrap();
+            assert_eq!(back.decode(&code).unwrap(), basis.decode(&code).unwrap());
+
+            let bytes = std::fs::read(&path).unwrap();
+            let mut flipped = bytes.clone();
+            let mid = flipped.len() / 2;
+            flipped[mid] ^= 0x40;
+            let bad = dir.path().join("flipped.basis");
+            std::fs::write(&bad, &flipped).unwrap();
+            let err = BaselineBasis::load(&bad).unwrap_err().to_string();
+            assert!(err.contains("checksum") && err.contains("flipped.basis"), "{err}");
+
+            std::fs::write(&bad, &bytes[..bytes.len() - 100]).unwrap();
+            let err = BaselineBasis::load(&bad).unwrap_err().to_string();
+            assert!(err.contains("truncated"), "{err}");
+
+            std::fs::write(&bad, b"P3\n2 2\n255\n").unwrap();
+            let err = BaselineBasis::load(&bad).unwrap_err().to_string();
+            assert!(err.contains("too short") || err.contains("magic"), "{err}");
+
+            // An absurd size in an otherwise well-formed header is refused before allocating.
+            let mut absurd = bytes.clone();
+            let k_at = 16 + basis.name().len() + 16;
+            absurd[k_at..k_at + 8].copy_from_slice(&u64::MAX.to_le_bytes());
+            std::fs::write(&bad, &absurd).unwrap();
+            let err = BaselineBasis::load(&bad).unwrap_err().to_string();
+            assert!(err.contains("absurd"), "{err}");
+        }
+        let missing = BaselineBasis::load(&dir.path().join("none.basis")).unwrap_err().to_string();
+        assert!(missing.contains("none.basis"), "{missing}");
+    }
+}

@@ -1,0 +1,237 @@
+//! Line charts with [`plotters`], written as SVG and PNG. PNG text uses the DejaVu Sans font
+//! embedded in the binary (the `dejavu` crate, through plotters' `ab_glyph` feature), so
+//! figures render identically with no system fonts installed.
+
+use crate::error::{EvalError, Result};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::FontTransform;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// One line of a chart.
+#[derive(Clone, Debug)]
+pub struct Series {
+    pub label: String,
+    /// (x, y) points; non-finite or (on a log axis) non-positive y values are skipped.
+    pub points: Vec<(f64, f64)>,
+}
+
+/// A line chart.
+#[derive(Clone, Debug)]
+pub struct LineChart {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub log_y: bool,
+    pub series: Vec<Series>,
+    /// Category names for integer x positions 0, 1, 2, ... (per-material charts); `None` for a
+    /// numeric x axis.
+    pub categories: Option<Vec<String>>,
+    /// Pixel size (width, height).
+    pub size: (u32, u32),
+}
+
+fn register_font() -> Result<()> {
+    static REGISTERED: OnceLock<bool> = OnceLock::new();
+    let ok = *REGISTERED.get_or_init(|| {
+        plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular()).is_ok()
+    });
+    if ok {
+        Ok(())
+    } else {
+        Err(EvalError::Invalid("the embedded DejaVu Sans font could not be loaded".into()))
+    }
+}
+
+/// Writes `chart` to `<stem>.svg` and `<stem>.png` (each through a temp file and a rename).
+pub fn write_chart(chart: &LineChart, stem: &Path) -> Result<()> {
+    register_font()?;
+    let (w, h) = chart.size;
+    let svg_path = with_ext(stem, "svg");
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
+        draw(&root, chart).map_err(|e| EvalError::Invalid(format!("{}: {e}", svg_path.display())))?;
+        root.present().map_err(|e| EvalError::Invalid(format!("{}: {e}", svg_path.display())))?;
+    }
+    write_atomic_file(&svg_path, svg.as_bytes())?;
+
+    let png_path = with_ext(stem, "png");
+    let mut buf = vec![255u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        draw(&root, chart).map_err(|e| EvalError::Invalid(format!("{}: {e}", png_path.display())))?;
+        root.present().map_err(|e| EvalError::Invalid(format!("{}: {e}", png_path.display())))?;
+    }
+    let img = image::RgbImage::from_raw(w, h, buf)
+        .ok_or_else(|| EvalError::Invalid("plot buffer has the wrong size".into()))?;
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .map_err(|e| EvalError::Invalid(format!("{}: {e}", png_path.display())))?;
+    write_atomic_file(&png_path, &png)
+}
+
+fn with_ext(stem: &Path, ext: &str) -> PathBuf {
+    let mut s = stem.as_os_str().to_owned();
+    s.push(".");
+    s.push(ext);
+    PathBuf::from(s)
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same directory and a rename.
+pub fn write_atomic_file(path: &Path, bytes: &[u8]) -> Result<()> {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.tmp"));
+    std::fs::write(&tmp, bytes).map_err(|e| EvalError::io(&tmp, e))?;
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        EvalError::io(path, e)
+    })
+}
+
+/// Distinct, print-friendly line colours.
+const COLOURS: [RGBColor; 10] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+];
+
+type DrawResult<DB> = std::result::Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
+
+fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &LineChart) -> DrawResult<DB> {
+    root.fill(&WHITE)?;
+    let keep = |y: f64| y.is_finite() && (!chart.log_y || y > 0.0);
+    let points = || chart.series.iter().flat_map(|s| s.points.iter()).filter(|p| keep(p.1) && p.0.is_finite());
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for &(x, y) in points() {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if x0 > x1 {
+        (x0, x1, y0, y1) = (0.0, 1.0, 1.0, 10.0);
+    }
+    if chart.categories.is_some() {
+        x0 -= 0.5;
+        x1 += 0.5;
+    } else {
+        let pad = ((x1 - x0) * 0.04).max(0.5);
+        x0 -= pad;
+        x1 += pad;
+    }
+    if chart.log_y {
+        y0 /= 1.5;
+        y1 *= 1.5;
+    } else {
+        let pad = ((y1 - y0) * 0.05).max(1e-12);
+        y0 -= pad;
+        y1 += pad;
+    }
+    let bottom = if chart.categories.is_some() { 190 } else { 60 };
+    let mut builder = ChartBuilder::on(root);
+    builder
+        .caption(&chart.title, ("sans-serif", 26))
+        .margin(16)
+        .x_label_area_size(bottom)
+        .y_label_area_size(100);
+
+    let categories = chart.categories.clone();
+    let x_fmt = move |x: &f64| match &categories {
+        Some(names) => {
+            let i = x.round();
+            if (x - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < names.len() {
+                names[i as usize].clone()
+            } else {
+                String::new()
+            }
+        }
+        None => format!("{x}"),
+    };
+    let x_labels = chart.categories.as_ref().map(|c| c.len()).unwrap_or(12);
+    let x_style = if chart.categories.is_some() {
+        TextStyle::from(("sans-serif", 11).into_font()).transform(FontTransform::Rotate90)
+    } else {
+        TextStyle::from(("sans-serif", 16).into_font())
+    };
+
+    macro_rules! finish {
+        ($ctx:expr) => {{
+            let mut ctx = $ctx;
+            ctx.configure_mesh()
+                .x_desc(&chart.x_label)
+                .y_desc(&chart.y_label)
+                .axis_desc_style(("sans-serif", 18))
+                .x_labels(x_labels)
+                .x_label_formatter(&x_fmt)
+                .x_label_style(x_style.clone())
+                .y_label_style(("sans-serif", 15))
+                .y_label_formatter(&|y: &f64| format!("{y:.3e}"))
+                .draw()?;
+            for (i, s) in chart.series.iter().enumerate() {
+                let colour = COLOURS[i % COLOURS.len()];
+                let pts: Vec<(f64, f64)> =
+                    s.points.iter().copied().filter(|p| keep(p.1) && p.0.is_finite()).collect();
+                ctx.draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))?
+                    .label(s.label.clone())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(3)));
+                ctx.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, colour.filled())))?;
+            }
+            ctx.configure_series_labels()
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .label_font(("sans-serif", 16))
+                .position(SeriesLabelPosition::UpperRight)
+                .draw()?;
+        }};
+    }
+    if chart.log_y {
+        finish!(builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale())?);
+    } else {
+        finish!(builder.build_cartesian_2d(x0..x1, y0..y1)?);
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn writes_svg_and_png_with_text() {
+        let dir = tempfile::tempdir().unwrap();
+        let chart = LineChart {
+            title: "error vs k".into(),
+            x_label: "k".into(),
+            y_label: "MSE".into(),
+            log_y: true,
+            series: vec![
+                Series { label: "PCA".into(), points: vec![(5.0, 0.3), (10.0, 0.1), (20.0, 0.05)] },
+                Series { label: "IPCA".into(), points: vec![(5.0, 0.03), (10.0, 0.01), (20.0, 0.0)] },
+            ],
+            categories: None,
+            size: (640, 420),
+        };
+        let stem = dir.path().join("chart");
+        write_chart(&chart, &stem).unwrap();
+        let svg = std::fs::read_to_string(dir.path().join("chart.svg")).unwrap();
+        assert!(svg.contains("IPCA") && svg.contains("error vs k"));
+        let png = image::open(dir.path().join("chart.png")).unwrap().to_rgb8();
+        assert_eq!(png.dimensions(), (640, 420));
+        // Text was rasterised: the title band (top 40 rows) holds dark pixels.
+        let dark = (0..640)
+            .flat_map(|x| (0..40).map(move |y| (x, y)))
+            .filter(|&(x, y)| png.get_pixel(x, y).0.iter().all(|&c| c < 100))
+            .count();
+        assert!(dark > 50, "no title text drawn ({dark} dark pixels)");
+    }
+}

@@ -1,0 +1,45 @@
+//! The interface every compression method implements, so PCA, IPCA and DeepBRDF run through the
+//! same harness: a [`Method`] is fitted to training tables and yields a [`Codec`] of k
+//! coefficients per BRDF. Both traits are object safe (`&dyn Method`, `Box<dyn Codec>`).
+
+use crate::error::Result;
+use deepbrdf_data::{MerlTable, Progress};
+
+/// A fitted representation with `k` coefficients per BRDF.
+pub trait Codec: Send + Sync {
+    /// A short label, e.g. "IPCA-10".
+    fn name(&self) -> String;
+    /// Number of coefficients per BRDF.
+    fn k(&self) -> usize;
+    /// The `k` coefficients of `table`.
+    fn encode(&self, table: &MerlTable) -> Result<Vec<f32>>;
+    /// The full table of `k` coefficients (invalid cells negative, as in MERL files).
+    fn decode(&self, code: &[f32]) -> Result<MerlTable>;
+}
+
+/// A way of fitting codecs to training BRDFs.
+pub trait Method: Sync {
+    /// The method's name in tables and plots ("PCA", "IPCA", "DeepBRDF").
+    fn name(&self) -> String;
+
+    /// Fits a codec of `k` coefficients to `train` (`names[i]` names `train[i]`).
+    fn fit(
+        &self,
+        train: &[&MerlTable],
+        names: &[String],
+        k: usize,
+        progress: &dyn Progress,
+    ) -> Result<Box<dyn Codec>>;
+
+    /// Fits one codec per entry of `ks`, in that order. The default fits each separately;
+    /// methods whose fits are nested (PCA) override it to fit once.
+    fn fit_ks(
+        &self,
+        train: &[&MerlTable],
+        names: &[String],
+        ks: &[usize],
+        progress: &dyn Progress,
+    ) -> Result<Vec<Box<dyn Codec>>> {
+        ks.iter().map(|&k| self.fit(train, names, k, progress)).collect()
+    }
+}

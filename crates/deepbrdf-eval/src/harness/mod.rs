@@ -1,0 +1,323 @@
+//! The evaluation harness (paper §4): fits each [`Method`] on the training materials of each
+//! fold of a [`Mode`], encodes and decodes every evaluation material at every k, and records
+//! each [`Measure`]. PCA, IPCA and DeepBRDF all run through [`run`] unchanged.
+
+mod codec;
+mod measures;
+mod modes;
+mod report;
+
+pub use codec::{Codec, Method};
+pub use measures::{Measure, Original, Yardstick};
+pub use modes::{Fold, Mode};
+pub use report::{FitTiming, Record, Results};
+
+use crate::error::{EvalError, Result};
+use deepbrdf_data::{MerlTable, Progress};
+use std::time::Instant;
+
+/// What to run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HarnessConfig {
+    /// Dimensions of the representation to evaluate.
+    pub ks: Vec<usize>,
+    pub mode: Mode,
+    /// Seed of the k-fold split.
+    pub seed: u64,
+    pub measures: Vec<Measure>,
+}
+
+impl HarnessConfig {
+    /// Checks the settings once (non-empty, distinct, positive k; at least one measure).
+    pub fn validate(&self) -> Result<()> {
+        if self.ks.is_empty() || self.ks.contains(&0) {
+            return Err(EvalError::Invalid("k values must be given and positive".into()));
+        }
+        let mut sorted = self.ks.clone();
+        sorted.sort_unstable();
+        sorted.dedup();
+        if sorted.len() != self.ks.len() {
+            return Err(EvalError::Invalid(format!("repeated k in {:?}", self.ks)));
+        }
+        if self.measures.is_empty() {
+            return Err(EvalError::Invalid("no measure selected".into()));
+        }
+        Ok(())
+    }
+}
+
+/// Named tables: the materials of a run (a `Dataset`'s names and tables).
+#[derive(Clone, Copy, Debug)]
+pub struct Materials<'a> {
+    pub names: &'a [String],
+    pub tables: &'a [MerlTable],
+    /// How the data came about, for the summary ("bundled merl (100)").
+    pub label: &'a str,
+}
+
+impl<'a> Materials<'a> {
+    fn check(&self) -> Result<()> {
+        if self.names.len() != self.tables.len() {
+            return Err(EvalError::Invalid(format!(
+                "{} names for {} tables",
+                self.names.len(),
+                self.tables.len()
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// Runs `methods` over `train` (and, in generalize mode, evaluates on `eval`).
+///
+/// In-sample and k-fold modes evaluate materials of `train` (and `eval` must be `None`);
+/// generalize mode fits on all of `train` and evaluates on all of `eval`. A k-fold run never
+/// evaluates a material with a codec fitted on it.
+pub fn run(
+    methods: &[&dyn Method],
+    config: &HarnessConfig,
+    train: Materials,
+    eval: Option<Materials>,
+    progress: &dyn Progress,
+) -> Result<Results> {
+    config.validate()?;
+    train.check()?;
+    if methods.is_empty() {
+        return Err(EvalError::Invalid("no method to evaluate".into()));
+    }
+    let eval_set = match (config.mode, eval) {
+        (Mode::Generalize, Some(e)) => {
+            e.check()?;
+            e
+        }
+        (Mode::Generalize, None) => {
+            return Err(EvalError::Invalid("generalize mode needs evaluation materials".into()))
+        }
+        (_, Some(_)) => {
+            return Err(EvalError::Invalid(format!(
+                "{} mode evaluates the training collection; no separate evaluation set",
+                config.mode
+            )))
+        }
+        (_, None) => train,
+    };
+    let started = Instant::now();
+    let folds = config.mode.folds(train.tables.len(), eval_set.tables.len(), config.seed)?;
+    let mut records = Vec::new();
+    let mut fits = Vec::new();
+    let mut eval_seconds = 0.0;
+    for fold in &folds {
+        let tables: Vec<&MerlTable> = fold.train.iter().map(|&i| &train.tables[i]).collect();
+        let names: Vec<String> = fold.train.iter().map(|&i| train.names[i].clone()).collect();
+        if config.mode != Mode::Generalize {
+            // Guard the promise of held-out modes explicitly.
+            if config.mode != Mode::InSample && fold.test.iter().any(|t| fold.train.contains(t)) {
+                return Err(EvalError::Invalid(format!("fold {} evaluates a training material", fold.index)));
+            }
+        }
+        let yardstick = Yardstick::from_training(&tables)?;
+        let mut codecs: Vec<(String, Vec<Box<dyn Codec>>)> = Vec::new();
+        for method in methods {
+            let t = Instant::now();
+            let fitted = method.fit_ks(&tables, &names, &config.ks, progress)?;
+            if fitted.len() != config.ks.len()
+                || fitted.iter().zip(&config.ks).any(|(c, &k)| c.k() != k)
+            {
+                return Err(EvalError::Invalid(format!(
+                    "{} returned codecs for k = {:?}, expected {:?}",
+                    method.name(),
+                    fitted.iter().map(|c| c.k()).collect::<Vec<_>>(),
+                    config.ks
+                )));
+            }
+            fits.push(FitTiming {
+                method: method.name(),
+                fold: fold.index,
+                n_train: tables.len(),
+                seconds: t.elapsed().as_secs_f64(),
+            });
+            codecs.push((method.name(), fitted));
+        }
+
+        let t = Instant::now();
+        let steps = fold.test.len() * codecs.iter().map(|c| c.1.len()).sum::<usize>();
+        progress.start(steps as u64, &format!("evaluating fold {}", fold.index + 1));
+        for &i in &fold.test {
+            let original = yardstick.original(&eval_set.tables[i]);
+            for (method, list) in &codecs {
+                for codec in list {
+                    let code = codec.encode(&eval_set.tables[i])?;
+                    if code.len() != codec.k() {
+                        return Err(EvalError::Invalid(format!(
+                            "{} encoded {} to {} coefficients",
+                            codec.name(),
+                            eval_set.names[i],
+                            code.len()
+                        )));
+                    }
+                    let recon = codec.decode(&code)?;
+                    let values = yardstick.measure(&original, &recon, &config.measures)?;
+                    for (&measure, value) in config.measures.iter().zip(values) {
+                        records.push(Record {
+                            method: method.clone(),
+                            k: codec.k(),
+                            fold: fold.index,
+                            material: eval_set.names[i].clone(),
+                            measure,
+                            value,
+                        });
+                    }
+                    progress.advance(1);
+                }
+            }
+        }
+        progress.finish();
+        eval_seconds += t.elapsed().as_secs_f64();
+    }
+    Ok(Results {
+        mode: config.mode,
+        seed: config.seed,
+        ks: config.ks.clone(),
+        methods: methods.iter().map(|m| m.name()).collect(),
+        measures: config.measures.clone(),
+        train_label: train.label.to_string(),
+        eval_label: eval_set.label.to_string(),
+        records,
+        fits,
+        eval_seconds,
+        total_seconds: started.elapsed().as_secs_f64(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::baseline::BaselineMethod;
+    use crate::testing::synthetic_set;
+    use deepbrdf_data::Silent;
+    use std::sync::Mutex;
+
+    fn methods() -> (BaselineMethod, BaselineMethod) {
+        (crate::pca::Pca::method(), crate::ipca::Ipca::method())
+    }
+
+    #[test]
+    fn in_sample_error_falls_with_k_and_vanishes_at_n_minus_1() {
+        let (names, tables) = synthetic_set(6);
+        let (pca, ipca) = methods();
+        let config = HarnessConfig {
+            ks: vec![1, 2, 5],
+            mode: Mode::InSample,
+            seed: 1,
+            measures: Measure::ALL.to_vec(),
+        };
+        let data = Materials { names: &names, tables: &tables, label: "synthetic" };
+        let results = run(&[&pca, &ipca], &config, data, None, &Silent).unwrap();
+        assert_eq!(results.records.len(), 2 * 3 * 6 * 2);
+        for method in ["PCA", "IPCA"] {
+            for m in Measure::ALL {
+                let e: Vec<f64> = [1, 2, 5].iter().map(|&k| results.mean(method, k, m).unwrap()).collect();
+                assert!(e[1] <= e[0] && e[2] <= e[1], "{method} {m}: {e:?}");
+                assert!(e[2] < 1e-8 * e[0].max(1e-30) + 1e-9, "{method} {m}: k = n-1 gives {e:?}");
+            }
+        }
+        let dir = tempfile::tempdir().unwrap();
+        results.write(dir.path()).unwrap();
+        let csv = std::fs::read_to_string(dir.path().join("results.csv")).unwrap();
+        assert_eq!(csv.lines().count(), 1 + results.records.len());
+        let md = std::fs::read_to_string(dir.path().join("summary.md")).unwrap();
+        assert!(md.contains("| IPCA |") && md.contains("k = 5"), "{md}");
+        for f in ["error_vs_k_mapped_mse.png", "per_material_cos_rmse.svg", "fits.csv"] {
+            assert!(dir.path().join(f).is_file(), "{f} missing");
+        }
+    }
+
+    /// A method whose codecs refuse to encode any table they were fitted on, and which records
+    /// the training sets it saw.
+    struct Spy {
+        fitted: Mutex<Vec<Vec<String>>>,
+    }
+
+    struct SpyCodec {
+        train: Vec<MerlTable>,
+        k: usize,
+    }
+
+    impl Codec for SpyCodec {
+        fn name(&self) -> String {
+            "spy".into()
+        }
+        fn k(&self) -> usize {
+            self.k
+        }
+        fn encode(&self, table: &MerlTable) -> Result<Vec<f32>> {
+            if self.train.iter().any(|t| t == table) {
+                return Err(EvalError::Invalid("evaluated a training material".into()));
+            }
+            Ok(vec![0.0; self.k])
+        }
+        fn decode(&self, _code: &[f32]) -> Result<MerlTable> {
+            Ok(self.train[0].clone())
+        }
+    }
+
+    impl Method for Spy {
+        fn name(&self) -> String {
+            "spy".into()
+        }
+        fn fit(&self, train: &[&MerlTable], names: &[String], k: usize, _p: &dyn Progress) -> Result<Box<dyn Codec>> {
+            self.fitted.lock().unwrap().push(names.to_vec());
+            Ok(Box::new(SpyCodec { train: train.iter().map(|t| (*t).clone()).collect(), k }))
+        }
+    }
+
+    #[test]
+    fn kfold_never_evaluates_a_material_it_was_fitted_on() {
+        let (names, tables) = synthetic_set(7);
+        let spy = Spy { fitted: Mutex::new(Vec::new()) };
+        let config = HarnessConfig {
+            ks: vec![2],
+            mode: Mode::KFold { folds: 3 },
+            seed: 5,
+            measures: vec![Measure::MappedMse],
+        };
+        let data = Materials { names: &names, tables: &tables, label: "synthetic" };
+        let results = run(&[&spy], &config, data, None, &Silent).unwrap();
+        // Every material evaluated exactly once, by a fold that did not train on it.
+        let mut evaluated: Vec<&str> = results.records.iter().map(|r| r.material.as_str()).collect();
+        evaluated.sort_unstable();
+        let mut all: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
+        all.sort_unstable();
+        assert_eq!(evaluated, all);
+        let fitted = spy.fitted.lock().unwrap();
+        assert_eq!(fitted.len(), 3);
+        for r in &results.records {
+            assert!(!fitted[r.fold].contains(&r.material), "{} in fold {}", r.material, r.fold);
+        }
+        // The same spy fails in-sample mode, which is the point of the check.
+        let in_sample = HarnessConfig { mode: Mode::InSample, ..config };
+        assert!(run(&[&spy], &in_sample, data, None, &Silent).is_err());
+    }
+
+    #[test]
+    fn generalize_fits_on_one_set_and_evaluates_another() {
+        let (names, tables) = synthetic_set(7);
+        let (pca, _) = methods();
+        let config = HarnessConfig {
+            ks: vec![2, 3],
+            mode: Mode::Generalize,
+            seed: 0,
+            measures: vec![Measure::MappedMse],
+        };
+        let train = Materials { names: &names[..5], tables: &tables[..5], label: "first five" };
+        let eval = Materials { names: &names[5..], tables: &tables[5..], label: "last two" };
+        let results = run(&[&pca], &config, train, Some(eval), &Silent).unwrap();
+        assert_eq!(results.materials(), names[5..].to_vec());
+        assert_eq!(results.fits[0].n_train, 5);
+        assert!(run(&[&pca], &config, train, None, &Silent).is_err());
+        let bad = HarnessConfig { ks: vec![2, 2], ..config.clone() };
+        assert!(run(&[&pca], &bad, train, Some(eval), &Silent).is_err());
+        let too_big = HarnessConfig { ks: vec![5], ..config };
+        assert!(run(&[&pca], &too_big, train, Some(eval), &Silent).is_err());
+    }
+}
