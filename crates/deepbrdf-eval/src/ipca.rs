@@ -63,7 +63,10 @@ mod tests {
                 for &w in &[1e-4, 0.05, 0.5, 1.0] {
                     let y = log_relative(rho, rho_ref, w);
                     let back = log_relative_inverse(y, rho_ref, w);
-                    assert!((back - rho).abs() <= 1e-9 * (1.0 + rho), "{rho} {rho_ref} {w}: {back}");
+                    assert!(
+                        (back - rho).abs() <= 1e-9 * (1.0 + rho),
+                        "{rho} {rho_ref} {w}: {back}"
+                    );
                 }
             }
         }

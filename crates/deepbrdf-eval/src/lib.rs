@@ -6,8 +6,8 @@ pub mod figures;
 pub mod harness;
 pub mod ipca;
 mod median_reference;
+pub mod pca;
 #[cfg(test)]
 mod testing;
-pub mod pca;
 
 pub use error::{EvalError, Result};

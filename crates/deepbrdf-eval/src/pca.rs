@@ -244,7 +244,8 @@ impl LinearBasis {
             for (c, out) in chunk.iter_mut().enumerate() {
                 let d = start + c;
                 let v = &self.components[d * kk..d * kk + k];
-                let s: f64 = v.iter().zip(code).map(|(&vj, &cj)| f64::from(vj) * f64::from(cj)).sum();
+                let s: f64 =
+                    v.iter().zip(code).map(|(&vj, &cj)| f64::from(vj) * f64::from(cj)).sum();
                 *out = (f64::from(self.mean[d]) + s) as f32;
             }
         });
@@ -332,8 +333,8 @@ mod tests {
         let (n, d, r) = (12, 2 * BLOCK + 77, 3);
         let rows = low_rank(n, d, r, 1);
         let basis = LinearBasis::fit(&refs(&rows), n - 1, &Silent).unwrap();
-        let scale = rows.iter().flatten().map(|x| f64::from(*x).powi(2)).sum::<f64>()
-            / (n * d) as f64;
+        let scale =
+            rows.iter().flatten().map(|x| f64::from(*x).powi(2)).sum::<f64>() / (n * d) as f64;
         for k in r..n {
             let mse = reconstruction_mse(&basis, &rows, k);
             assert!(mse < 1e-9 * scale, "k = {k}: mse {mse} (data scale {scale})");
@@ -341,7 +342,11 @@ mod tests {
         // Below the rank the error is clearly non-zero.
         assert!(reconstruction_mse(&basis, &rows, r - 1) > 1e-3 * scale);
         // Directions beyond the rank are at the noise floor and dropped.
-        assert!(basis.singular_values()[r..].iter().all(|&s| s == 0.0), "{:?}", basis.singular_values());
+        assert!(
+            basis.singular_values()[r..].iter().all(|&s| s == 0.0),
+            "{:?}",
+            basis.singular_values()
+        );
     }
 
     #[test]
@@ -397,9 +402,8 @@ mod tests {
                 basis.singular_values()[j]
             );
             // Same direction up to sign.
-            let dot: f64 = (0..d)
-                .map(|x| v_t[(order[j], x)] * f64::from(basis.components()[x * k + j]))
-                .sum();
+            let dot: f64 =
+                (0..d).map(|x| v_t[(order[j], x)] * f64::from(basis.components()[x * k + j])).sum();
             assert!((dot.abs() - 1.0).abs() < 1e-5, "component {j}: |cos| = {}", dot.abs());
         }
     }

@@ -60,12 +60,10 @@ impl FromStr for DeviceKind {
 
     /// Parses a device name; refuses kinds not compiled in, naming the feature to build with.
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let kind = Self::ALL
-            .into_iter()
-            .find(|k| k.name().eq_ignore_ascii_case(s.trim()))
-            .ok_or_else(|| {
-                format!("unknown device '{s}': expected one of flex, ndarray, wgpu, cuda")
-            })?;
+        let kind =
+            Self::ALL.into_iter().find(|k| k.name().eq_ignore_ascii_case(s.trim())).ok_or_else(
+                || format!("unknown device '{s}': expected one of flex, ndarray, wgpu, cuda"),
+            )?;
         if !kind.is_compiled() {
             let have: Vec<_> = Self::available().iter().map(|k| k.name()).collect();
             return Err(format!(

@@ -48,7 +48,12 @@ pub struct MerlTable {
 
 impl std::fmt::Debug for MerlTable {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "MerlTable {{ {} values, {} valid cells }}", self.values.len(), self.valid_cells())
+        write!(
+            f,
+            "MerlTable {{ {} values, {} valid cells }}",
+            self.values.len(),
+            self.valid_cells()
+        )
     }
 }
 

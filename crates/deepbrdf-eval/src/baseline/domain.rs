@@ -40,7 +40,9 @@ impl Domain {
         if cells.is_empty() {
             return Err(EvalError::Invalid("an empty domain".into()));
         }
-        if cells.windows(2).any(|w| w[0] >= w[1]) || cells.last().is_some_and(|&c| c as usize >= CELLS) {
+        if cells.windows(2).any(|w| w[0] >= w[1])
+            || cells.last().is_some_and(|&c| c as usize >= CELLS)
+        {
             return Err(EvalError::Invalid("domain cells are not increasing cell indices".into()));
         }
         Ok(Self { cells })

@@ -60,18 +60,29 @@ impl Mapping {
                 row[domain.row_index(c, m)] = reference[c * CELLS + cell as usize];
             }
         }
-        let cos_weight = domain.cells().iter().map(|&c| ipca::cos_product(c as usize) as f32).collect::<Vec<_>>();
+        let cos_weight = domain
+            .cells()
+            .iter()
+            .map(|&c| ipca::cos_product(c as usize) as f32)
+            .collect::<Vec<_>>();
         debug_assert_eq!(cos_weight.len(), n);
         Self::log_relative_from_parts(domain, row, cos_weight)
     }
 
     /// IPCA's mapping from a row-ordered reference and per-cell weights (an artifact).
-    pub fn log_relative_from_parts(domain: &Domain, reference: Vec<f32>, cos_weight: Vec<f32>) -> Result<Self> {
+    pub fn log_relative_from_parts(
+        domain: &Domain,
+        reference: Vec<f32>,
+        cos_weight: Vec<f32>,
+    ) -> Result<Self> {
         if reference.len() != domain.dim() || cos_weight.len() != domain.cells().len() {
             return Err(EvalError::Invalid("IPCA reference does not match its domain".into()));
         }
         if let Some(i) = reference.iter().position(|r| !(r.is_finite() && *r >= 0.0)) {
-            return Err(EvalError::Invalid(format!("IPCA reference value {i} is {}", reference[i])));
+            return Err(EvalError::Invalid(format!(
+                "IPCA reference value {i} is {}",
+                reference[i]
+            )));
         }
         if cos_weight.iter().any(|w| !(w.is_finite() && *w > 0.0)) {
             return Err(EvalError::Invalid("IPCA cosine weight not positive on the domain".into()));

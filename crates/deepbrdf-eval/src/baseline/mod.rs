@@ -176,7 +176,12 @@ impl BaselineMethod {
     }
 
     /// Fits one basis of `k` components.
-    pub fn fit_basis(&self, train: &[&MerlTable], k: usize, progress: &dyn Progress) -> Result<BaselineBasis> {
+    pub fn fit_basis(
+        &self,
+        train: &[&MerlTable],
+        k: usize,
+        progress: &dyn Progress,
+    ) -> Result<BaselineBasis> {
         BaselineBasis::fit(&self.name, self.kind, train, k, progress)
     }
 }
@@ -205,7 +210,8 @@ impl Method for BaselineMethod {
         ks: &[usize],
         progress: &dyn Progress,
     ) -> Result<Vec<Box<dyn Codec>>> {
-        let k_max = ks.iter().copied().max().ok_or_else(|| EvalError::Invalid("no k given".into()))?;
+        let k_max =
+            ks.iter().copied().max().ok_or_else(|| EvalError::Invalid("no k given".into()))?;
         let basis = Arc::new(self.fit_basis(train, k_max, progress)?);
         ks.iter().map(|&k| Ok(Box::new(basis.codec(k)?) as Box<dyn Codec>)).collect()
     }

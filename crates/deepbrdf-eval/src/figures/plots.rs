@@ -35,7 +35,8 @@ pub struct LineChart {
 fn register_font() -> Result<()> {
     static REGISTERED: OnceLock<bool> = OnceLock::new();
     let ok = *REGISTERED.get_or_init(|| {
-        plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular()).is_ok()
+        plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular())
+            .is_ok()
     });
     if ok {
         Ok(())
@@ -52,7 +53,8 @@ pub fn write_chart(chart: &LineChart, stem: &Path) -> Result<()> {
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
-        draw(&root, chart).map_err(|e| EvalError::Invalid(format!("{}: {e}", svg_path.display())))?;
+        draw(&root, chart)
+            .map_err(|e| EvalError::Invalid(format!("{}: {e}", svg_path.display())))?;
         root.present().map_err(|e| EvalError::Invalid(format!("{}: {e}", svg_path.display())))?;
     }
     write_atomic_file(&svg_path, svg.as_bytes())?;
@@ -61,7 +63,8 @@ pub fn write_chart(chart: &LineChart, stem: &Path) -> Result<()> {
     let mut buf = vec![255u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
-        draw(&root, chart).map_err(|e| EvalError::Invalid(format!("{}: {e}", png_path.display())))?;
+        draw(&root, chart)
+            .map_err(|e| EvalError::Invalid(format!("{}: {e}", png_path.display())))?;
         root.present().map_err(|e| EvalError::Invalid(format!("{}: {e}", png_path.display())))?;
     }
     let img = image::RgbImage::from_raw(w, h, buf)
@@ -105,12 +108,15 @@ const COLOURS: [RGBColor; 10] = [
     RGBColor(23, 190, 207),
 ];
 
-type DrawResult<DB> = std::result::Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
+type DrawResult<DB> =
+    std::result::Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
 
 fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &LineChart) -> DrawResult<DB> {
     root.fill(&WHITE)?;
     let keep = |y: f64| y.is_finite() && (!chart.log_y || y > 0.0);
-    let points = || chart.series.iter().flat_map(|s| s.points.iter()).filter(|p| keep(p.1) && p.0.is_finite());
+    let points = || {
+        chart.series.iter().flat_map(|s| s.points.iter()).filter(|p| keep(p.1) && p.0.is_finite())
+    };
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for &(x, y) in points() {
         x0 = x0.min(x);
@@ -183,7 +189,9 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &LineChart) ->
                     s.points.iter().copied().filter(|p| keep(p.1) && p.0.is_finite()).collect();
                 ctx.draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))?
                     .label(s.label.clone())
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(3)));
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(3))
+                    });
                 ctx.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, colour.filled())))?;
             }
             ctx.configure_series_labels()
@@ -216,7 +224,10 @@ mod tests {
             log_y: true,
             series: vec![
                 Series { label: "PCA".into(), points: vec![(5.0, 0.3), (10.0, 0.1), (20.0, 0.05)] },
-                Series { label: "IPCA".into(), points: vec![(5.0, 0.03), (10.0, 0.01), (20.0, 0.0)] },
+                Series {
+                    label: "IPCA".into(),
+                    points: vec![(5.0, 0.03), (10.0, 0.01), (20.0, 0.0)],
+                },
             ],
             categories: None,
             size: (640, 420),

@@ -52,10 +52,9 @@ impl fmt::Display for Measure {
 impl FromStr for Measure {
     type Err = EvalError;
     fn from_str(s: &str) -> Result<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| EvalError::Invalid(format!("unknown measure '{s}' (mapped_mse, cos_rmse)")))
+        Self::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
+            EvalError::Invalid(format!("unknown measure '{s}' (mapped_mse, cos_rmse)"))
+        })
     }
 }
 
@@ -76,10 +75,8 @@ impl Yardstick {
     /// The yardstick of a training set: eq. (1)'s reference is their per-value median.
     pub fn from_training(train: &[&MerlTable]) -> Result<Self> {
         let reference = MedianReference::from_tables(train)?;
-        let cos_weight = (0..CELLS)
-            .into_par_iter()
-            .map(|c| ipca::cos_product(c).max(0.0) as f32)
-            .collect();
+        let cos_weight =
+            (0..CELLS).into_par_iter().map(|c| ipca::cos_product(c).max(0.0) as f32).collect();
         Ok(Self { reference, cos_weight })
     }
 
@@ -89,7 +86,12 @@ impl Yardstick {
     }
 
     /// All `measures` of `recon` against `original`, in the given order.
-    pub fn measure(&self, original: &Original, recon: &MerlTable, measures: &[Measure]) -> Result<Vec<f64>> {
+    pub fn measure(
+        &self,
+        original: &Original,
+        recon: &MerlTable,
+        measures: &[Measure],
+    ) -> Result<Vec<f64>> {
         if recon.values().len() != VALUES {
             return Err(EvalError::Invalid("reconstruction is not a full table".into()));
         }

@@ -112,7 +112,10 @@ pub fn run(
         if config.mode != Mode::Generalize {
             // Guard the promise of held-out modes explicitly.
             if config.mode != Mode::InSample && fold.test.iter().any(|t| fold.train.contains(t)) {
-                return Err(EvalError::Invalid(format!("fold {} evaluates a training material", fold.index)));
+                return Err(EvalError::Invalid(format!(
+                    "fold {} evaluates a training material",
+                    fold.index
+                )));
             }
         }
         let yardstick = Yardstick::from_training(&tables)?;
@@ -216,7 +219,8 @@ mod tests {
         assert_eq!(results.records.len(), 2 * 3 * 6 * 2);
         for method in ["PCA", "IPCA"] {
             for m in Measure::ALL {
-                let e: Vec<f64> = [1, 2, 5].iter().map(|&k| results.mean(method, k, m).unwrap()).collect();
+                let e: Vec<f64> =
+                    [1, 2, 5].iter().map(|&k| results.mean(method, k, m).unwrap()).collect();
                 assert!(e[1] <= e[0] && e[2] <= e[1], "{method} {m}: {e:?}");
                 assert!(e[2] < 1e-8 * e[0].max(1e-30) + 1e-9, "{method} {m}: k = n-1 gives {e:?}");
             }
@@ -265,7 +269,13 @@ mod tests {
         fn name(&self) -> String {
             "spy".into()
         }
-        fn fit(&self, train: &[&MerlTable], names: &[String], k: usize, _p: &dyn Progress) -> Result<Box<dyn Codec>> {
+        fn fit(
+            &self,
+            train: &[&MerlTable],
+            names: &[String],
+            k: usize,
+            _p: &dyn Progress,
+        ) -> Result<Box<dyn Codec>> {
             self.fitted.lock().unwrap().push(names.to_vec());
             Ok(Box::new(SpyCodec { train: train.iter().map(|t| (*t).clone()).collect(), k }))
         }
@@ -284,7 +294,8 @@ mod tests {
         let data = Materials { names: &names, tables: &tables, label: "synthetic" };
         let results = run(&[&spy], &config, data, None, &Silent).unwrap();
         // Every material evaluated exactly once, by a fold that did not train on it.
-        let mut evaluated: Vec<&str> = results.records.iter().map(|r| r.material.as_str()).collect();
+        let mut evaluated: Vec<&str> =
+            results.records.iter().map(|r| r.material.as_str()).collect();
         evaluated.sort_unstable();
         let mut all: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
         all.sort_unstable();

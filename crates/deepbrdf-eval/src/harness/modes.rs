@@ -35,7 +35,9 @@ impl FromStr for Mode {
                         ))
                     })?;
                 if folds < 2 {
-                    return Err(EvalError::Invalid(format!("kfold needs at least 2 folds, got {folds}")));
+                    return Err(EvalError::Invalid(format!(
+                        "kfold needs at least 2 folds, got {folds}"
+                    )));
                 }
                 Ok(Self::KFold { folds })
             }
@@ -71,7 +73,9 @@ impl Mode {
             Self::InSample => Ok(vec![Fold { index: 0, train: all.clone(), test: all }]),
             Self::Generalize => {
                 if n_eval == 0 {
-                    return Err(EvalError::Invalid("generalize mode has no evaluation materials".into()));
+                    return Err(EvalError::Invalid(
+                        "generalize mode has no evaluation materials".into(),
+                    ));
                 }
                 Ok(vec![Fold { index: 0, train: all, test: (0..n_eval).collect() }])
             }

@@ -60,13 +60,21 @@ impl Results {
     }
 
     /// Per-material values of `measure` for `method` at `k`, in `materials` order.
-    pub fn per_material(&self, method: &str, k: usize, measure: Measure, materials: &[String]) -> Vec<f64> {
+    pub fn per_material(
+        &self,
+        method: &str,
+        k: usize,
+        measure: Measure,
+        materials: &[String],
+    ) -> Vec<f64> {
         materials
             .iter()
             .map(|m| {
                 self.records
                     .iter()
-                    .find(|r| r.method == method && r.k == k && r.measure == measure && &r.material == m)
+                    .find(|r| {
+                        r.method == method && r.k == k && r.measure == measure && &r.material == m
+                    })
                     .map_or(f64::NAN, |r| r.value)
             })
             .collect()
@@ -88,7 +96,12 @@ impl Results {
     pub fn summary_table(&self) -> String {
         let mut s = String::new();
         for &m in &self.measures {
-            let _ = writeln!(s, "Mean {} over {} evaluated materials:\n", m.label(), self.materials().len());
+            let _ = writeln!(
+                s,
+                "Mean {} over {} evaluated materials:\n",
+                m.label(),
+                self.materials().len()
+            );
             let _ = write!(s, "| method |");
             self.ks.iter().for_each(|k| {
                 let _ = write!(s, " k = {k} |");
@@ -126,7 +139,8 @@ impl Results {
         );
         s.push_str(&self.summary_table());
         let _ = writeln!(s, "Fit times (all k from one fit per method and fold):\n");
-        let _ = writeln!(s, "| method | fold | training materials | seconds |\n|---|---:|---:|---:|");
+        let _ =
+            writeln!(s, "| method | fold | training materials | seconds |\n|---|---:|---:|---:|");
         for f in &self.fits {
             let _ = writeln!(s, "| {} | {} | {} | {:.2} |", f.method, f.fold, f.n_train, f.seconds);
         }
@@ -161,10 +175,20 @@ impl Results {
         crate::figures::write_atomic_file(&dir.join("results.csv"), csv.as_bytes())?;
         let mut fits = String::from("method,fold,n_train,seconds\n");
         for f in &self.fits {
-            let _ = writeln!(fits, "{},{},{},{:.3}", csv_field(&f.method), f.fold, f.n_train, f.seconds);
+            let _ = writeln!(
+                fits,
+                "{},{},{},{:.3}",
+                csv_field(&f.method),
+                f.fold,
+                f.n_train,
+                f.seconds
+            );
         }
         crate::figures::write_atomic_file(&dir.join("fits.csv"), fits.as_bytes())?;
-        crate::figures::write_atomic_file(&dir.join("summary.md"), self.summary_markdown().as_bytes())?;
+        crate::figures::write_atomic_file(
+            &dir.join("summary.md"),
+            self.summary_markdown().as_bytes(),
+        )?;
 
         let materials = self.materials();
         for &m in &self.measures {
