@@ -1,6 +1,9 @@
 //! `deepbrdf-data`: measured BRDF data for DeepBRDF (Hu et al., CGF 2020, §3.1).
+pub mod bundled;
+pub mod cache;
 pub mod error;
 pub mod merl;
+pub mod nbrdf;
 pub mod progress;
 
 pub use error::{DataError, Result};
