@@ -1,6 +1,7 @@
 //! `deepbrdf-data`: measured BRDF data for DeepBRDF (Hu et al., CGF 2020, §3.1).
 pub mod error;
 mod files;
+pub mod layout;
 pub mod mapping;
 pub mod merl;
 pub mod progress;
