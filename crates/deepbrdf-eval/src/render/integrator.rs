@@ -161,7 +161,8 @@ fn shade(
             return out;
         };
         let dir = frame.to_world(wi);
-        (wi, dir, env.radiance(dir), env.pdf(dir))
+        let (radiance, pdf) = env.eval(dir);
+        (wi, dir, radiance, pdf)
     };
     if wi.z <= 0.0 || radiance.iter().all(|&v| v <= 0.0) {
         return out;

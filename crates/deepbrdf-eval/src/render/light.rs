@@ -54,6 +54,15 @@ impl Environment {
         }
     }
 
+    /// Radiance from `dir` and the density of [`Environment::sample`] there, together.
+    #[inline]
+    pub fn eval(&self, dir: Vec3) -> (Rgb, f64) {
+        match self {
+            Self::Constant(l) => (*l, 1.0 / (4.0 * PI)),
+            Self::SunSky(s) => s.eval(dir),
+        }
+    }
+
     /// Solid-angle density of [`Environment::sample`] at `dir`.
     #[inline]
     pub fn pdf(&self, dir: Vec3) -> f64 {

@@ -17,6 +17,7 @@ pub mod integrator;
 pub mod light;
 pub mod scene;
 pub mod shape;
+pub mod sheet;
 pub mod sky;
 
 pub use brdf::{Brdf, Ggx, Lambertian, SamplingLobe, Sum};
@@ -26,4 +27,5 @@ pub use integrator::{render, RenderSettings};
 pub use light::{DirectionalLight, Environment, LightSpec, Lighting};
 pub use scene::{Scene, SceneConfig};
 pub use shape::Shape;
+pub use sheet::{contact_sheet, SheetConfig, Tile};
 pub use sky::{SunSky, SunSkyConfig};

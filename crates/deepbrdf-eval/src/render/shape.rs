@@ -58,7 +58,7 @@ impl FromStr for Shape {
             "sphere" => Self::Sphere { radius: 1.0 },
             "plane" => Self::Plane { half: 1.0 },
             "torus" => Self::Torus { major: 0.7, minor: 0.3 },
-            "ellipsoid" => Self::Ellipsoid { radii: [1.0, 0.65, 0.45] },
+            "ellipsoid" => Self::Ellipsoid { radii: [0.75, 1.0, 0.55] },
             "cylinder" => Self::Cylinder { radius: 0.55, half_height: 0.8 },
             _ => {
                 return Err(EvalError::Invalid(format!(
@@ -378,7 +378,7 @@ mod tests {
         let t = |name: &str| name.parse::<Shape>().unwrap().intersect(&ray, 0.0).map(|h| h.t);
         assert!((t("sphere").unwrap() - 4.0).abs() < 1e-12);
         assert!((t("torus").unwrap() - 4.0).abs() < 1e-9); // outer equator at R + r = 1
-        assert!((t("ellipsoid").unwrap() - 4.0).abs() < 1e-12);
+        assert!((t("ellipsoid").unwrap() - 4.25).abs() < 1e-12);
         assert!((t("cylinder").unwrap() - 4.45).abs() < 1e-12);
         assert!(t("plane").is_none()); // parallel to the plane
                                        // Down the torus's axis: through the hole.

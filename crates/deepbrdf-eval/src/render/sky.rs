@@ -167,14 +167,24 @@ pub fn sun_transmittance(theta_s: f64, turbidity: f64) -> Rgb {
     RGB_WAVELENGTHS_UM.map(|l: f64| (-m * (0.008735 * l.powf(-4.08) + beta * l.powf(-1.3))).exp())
 }
 
+/// One cell of the tabulated sky.
+#[derive(Clone, Copy, Debug)]
+struct SkyCell {
+    radiance: [f32; 3],
+    /// `(1 - sun_prob) * pdf(u, v) / pi^2`: solid-angle density times `sin(theta)`.
+    pdf_sin: f32,
+}
+
 /// The sun and sky as an environment light, tabulated and ready for importance sampling.
 #[derive(Clone, Debug)]
 pub struct SunSky {
     config: SunSkyConfig,
     width: usize,
     height: usize,
-    /// Scaled sky radiance per cell, row-major over (zenith angle, azimuth).
-    map: Vec<[f32; 3]>,
+    /// Per map cell, row-major over (zenith angle, azimuth): scaled sky radiance and the
+    /// sky-sampling density with respect to `sin(theta) dtheta dphi` (divide by `sin(theta)` for
+    /// solid angle), precomputed so one lookup gives both.
+    cells: Vec<SkyCell>,
     distribution: Distribution2D,
     sun: Vec3,
     sun_frame: Frame,
@@ -248,16 +258,23 @@ impl SunSky {
         if !scale.is_finite() || scale <= 0.0 {
             return Err(EvalError::Invalid(format!("sun and sky of {c:?} carry no light")));
         }
-        for v in map.iter_mut() {
-            *v = v.map(|x| (f64::from(x) * scale) as f32);
-        }
         let sun_prob = (sun_irradiance / (sun_irradiance + sky_power)).clamp(0.1, 0.9);
+        let distribution = Distribution2D::new(&weight, width, height);
+        let cells = map
+            .iter()
+            .enumerate()
+            .map(|(i, rgb)| SkyCell {
+                radiance: rgb.map(|x| (f64::from(x) * scale) as f32),
+                pdf_sin: ((1.0 - sun_prob) * distribution.pdf_cell(i % width, i / width)
+                    / (PI * PI)) as f32,
+            })
+            .collect();
         Ok(Self {
             config,
             width,
             height,
-            map,
-            distribution: Distribution2D::new(&weight, width, height),
+            cells,
+            distribution,
             sun,
             sun_frame: Frame::from_normal(sun),
             cos_sun_radius,
@@ -307,37 +324,47 @@ impl SunSky {
             return [0.0; 3];
         }
         let (col, row) = self.cell(dir);
-        self.map[row * self.width + col].map(f64::from)
+        self.cells[row * self.width + col].radiance.map(f64::from)
     }
 
     /// Radiance arriving from unit direction `dir`: the sky, plus the sun inside its disk.
     #[inline]
     pub fn radiance(&self, dir: Vec3) -> Rgb {
-        let mut l = self.sky_radiance(dir);
-        if self.in_sun(dir) {
-            for (a, s) in l.iter_mut().zip(self.sun_radiance) {
-                *a += s;
-            }
-        }
-        l
+        self.eval(dir).0
     }
 
     /// Solid-angle density of [`SunSky::sample`] at `dir`.
     #[inline]
     pub fn pdf(&self, dir: Vec3) -> f64 {
-        let mut p = 0.0;
-        if self.in_sun(dir) {
-            p += self.sun_prob / self.sun_solid_angle;
-        }
+        self.eval(dir).1
+    }
+
+    /// Radiance from `dir` and the density of [`SunSky::sample`] there, in one map lookup.
+    #[inline]
+    pub fn eval(&self, dir: Vec3) -> (Rgb, f64) {
+        let (mut l, mut p) = ([0.0; 3], 0.0);
         if dir.z > 0.0 {
             let (col, row) = self.cell(dir);
+            let cell = &self.cells[row * self.width + col];
             let sin_theta = (1.0 - dir.z * dir.z).max(0.0).sqrt();
+            l = cell.radiance.map(f64::from);
             if sin_theta > 0.0 {
-                p += (1.0 - self.sun_prob) * self.distribution.pdf_cell(col, row)
-                    / (PI * PI * sin_theta);
+                p = f64::from(cell.pdf_sin) / sin_theta;
             }
         }
-        p
+        self.add_sun(dir, l, p)
+    }
+
+    /// Adds the sun's radiance and sampling density at `dir`, if it lies in the disk.
+    #[inline]
+    fn add_sun(&self, dir: Vec3, mut l: Rgb, mut p: f64) -> (Rgb, f64) {
+        if self.in_sun(dir) {
+            for (a, s) in l.iter_mut().zip(self.sun_radiance) {
+                *a += s;
+            }
+            p += self.sun_prob / self.sun_solid_angle;
+        }
+        (l, p)
     }
 
     /// Draws a direction from `u` uniform in [0,1)^2: the sun disk (uniform in its cone) with
@@ -345,18 +372,25 @@ impl SunSky {
     /// its radiance and its density ([`SunSky::pdf`]).
     #[inline]
     pub fn sample(&self, u: [f64; 2]) -> (Vec3, Rgb, f64) {
-        let dir = if u[0] < self.sun_prob {
+        if u[0] < self.sun_prob {
             let u0 = u[0] / self.sun_prob;
             let cos_t = 1.0 - u0 * (1.0 - self.cos_sun_radius);
             let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
             let (s, c) = (2.0 * PI * u[1]).sin_cos();
-            self.sun_frame.to_world(Vec3::new(sin_t * c, sin_t * s, cos_t))
+            let dir = self.sun_frame.to_world(Vec3::new(sin_t * c, sin_t * s, cos_t));
+            let (l, p) = self.eval(dir);
+            (dir, l, p)
         } else {
             let u0 = (u[0] - self.sun_prob) / (1.0 - self.sun_prob);
-            let (uv, _, _) = self.distribution.sample([u0, u[1]]);
-            Vec3::from_spherical(uv[1] * FRAC_PI_2, uv[0] * 2.0 * PI)
-        };
-        (dir, self.radiance(dir), self.pdf(dir))
+            let (uv, (col, row), _) = self.distribution.sample([u0, u[1]]);
+            let dir = Vec3::from_spherical(uv[1] * FRAC_PI_2, uv[0] * 2.0 * PI);
+            // The cell is known: no angle computations, the sky's part read directly.
+            let cell = &self.cells[row * self.width + col];
+            let sin_theta = (1.0 - dir.z * dir.z).max(0.0).sqrt();
+            let p = if sin_theta > 0.0 { f64::from(cell.pdf_sin) / sin_theta } else { 0.0 };
+            let (l, p) = self.add_sun(dir, cell.radiance.map(f64::from), p);
+            (dir, l, p)
+        }
     }
 }
 
