@@ -148,8 +148,20 @@ impl Shape {
         let (o, d) = (ray.origin, ray.dir);
         match *self {
             Self::Sphere { radius } => {
-                let t =
-                    quadratic_first(1.0, o.dot(d), o.length_squared() - radius * radius, t_min)?;
+                // |d| = 1: t = -b -/+ sqrt(b^2 - c), no division.
+                let b = o.dot(d);
+                let disc = b * b - (o.length_squared() - radius * radius);
+                if disc < 0.0 {
+                    return None;
+                }
+                let sq = disc.sqrt();
+                let t = if -b - sq > t_min {
+                    -b - sq
+                } else if -b + sq > t_min {
+                    -b + sq
+                } else {
+                    return None;
+                };
                 let p = ray.at(t);
                 Some(Hit { t, point: p, normal: p * (1.0 / radius) })
             }

@@ -11,7 +11,7 @@ use super::distribution::Distribution2D;
 use super::geometry::{Frame, Vec3};
 use crate::error::{EvalError, Result};
 use serde::{Deserialize, Serialize};
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::PI;
 
 /// Parameters of the sun and sky.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -24,7 +24,10 @@ pub struct SunSkyConfig {
     pub turbidity: f64,
     /// Angular radius of the sun disk, degrees (the real sun: 0.2665).
     pub sun_radius_deg: f64,
-    /// Columns (azimuth) of the tabulated sky; rows are half as many (zenith angle 0-90 deg).
+    /// Columns (azimuth, 0-360 deg) of the tabulated sky; rows (zenith angle, 0-90 deg) are a
+    /// quarter as many, so cells are about square. The default, 256, gives 1.4 degree cells
+    /// (256 KB, small enough to stay in cache); the sky is smooth at that scale, and the sun,
+    /// the only sharp feature, is not in the map.
     pub map_width: usize,
 }
 
@@ -35,7 +38,7 @@ impl Default for SunSkyConfig {
             azimuth_deg: 30.0,
             turbidity: 3.0,
             sun_radius_deg: 0.2665,
-            map_width: 512,
+            map_width: 256,
         }
     }
 }
@@ -171,8 +174,8 @@ pub fn sun_transmittance(theta_s: f64, turbidity: f64) -> Rgb {
 #[derive(Clone, Copy, Debug)]
 struct SkyCell {
     radiance: [f32; 3],
-    /// `(1 - sun_prob) * pdf(u, v) / pi^2`: solid-angle density times `sin(theta)`.
-    pdf_sin: f32,
+    /// `(1 - sun_prob) * pdf(u, v) / (4 pi)`: solid-angle density times `v`.
+    pdf_v: f32,
 }
 
 /// The sun and sky as an environment light, tabulated and ready for importance sampling.
@@ -181,9 +184,9 @@ pub struct SunSky {
     config: SunSkyConfig,
     width: usize,
     height: usize,
-    /// Per map cell, row-major over (zenith angle, azimuth): scaled sky radiance and the
-    /// sky-sampling density with respect to `sin(theta) dtheta dphi` (divide by `sin(theta)` for
-    /// solid angle), precomputed so one lookup gives both.
+    /// Per map cell, row-major over (v = sqrt(1 - cos theta), azimuth): scaled sky radiance and
+    /// the sky-sampling density times `v` (divide by `v` for solid angle), precomputed so one
+    /// lookup gives both.
     cells: Vec<SkyCell>,
     distribution: Distribution2D,
     sun: Vec3,
@@ -218,7 +221,7 @@ impl SunSky {
                 c.sun_radius_deg
             )));
         }
-        if !(8..=8192).contains(&c.map_width) {
+        if !(8..=8192).contains(&c.map_width) || c.map_width % 4 != 0 {
             return Err(EvalError::Invalid(format!(
                 "sky map width {} not in 8..=8192",
                 c.map_width
@@ -227,21 +230,24 @@ impl SunSky {
         let theta_s = (90.0 - c.elevation_deg).to_radians();
         let sun = Vec3::from_spherical(theta_s, c.azimuth_deg.to_radians());
         let sky = PreethamSky::new(sun, c.turbidity);
-        let (width, height) = (c.map_width, c.map_width / 2);
-        let (d_phi, d_theta) = (2.0 * PI / width as f64, FRAC_PI_2 / height as f64);
-
+        let (width, height) = (c.map_width, c.map_width / 4);
+        // Rows are uniform in v = sqrt(1 - cos(theta)) (nearly uniform in theta, and free of
+        // acos when indexing); the solid angle is dw = dphi dz = 2 v dv dphi.
+        let (d_phi, d_v) = (2.0 * PI / width as f64, 1.0 / height as f64);
         let mut map = Vec::with_capacity(width * height);
         let mut weight = Vec::with_capacity(width * height);
         let (mut sky_power, mut sky_facing) = (0.0, 0.0);
         for row in 0..height {
-            let theta = (row as f64 + 0.5) * d_theta;
-            let solid = d_phi * ((row as f64 * d_theta).cos() - ((row + 1) as f64 * d_theta).cos());
+            let (v0, v1) = (row as f64 * d_v, (row + 1) as f64 * d_v);
+            let v = 0.5 * (v0 + v1);
+            let theta = (1.0 - v * v).clamp(-1.0, 1.0).acos();
+            let solid = d_phi * (v1 * v1 - v0 * v0);
             for col in 0..width {
                 let dir = Vec3::from_spherical(theta, (col as f64 + 0.5) * d_phi);
                 let l = sky.radiance(dir);
                 let y = luminance(l);
                 map.push(l.map(|v| v as f32));
-                weight.push(y * theta.sin());
+                weight.push(y * v);
                 sky_power += y * solid;
                 sky_facing += y * solid * dir.dot(sun).max(0.0);
             }
@@ -265,8 +271,8 @@ impl SunSky {
             .enumerate()
             .map(|(i, rgb)| SkyCell {
                 radiance: rgb.map(|x| (f64::from(x) * scale) as f32),
-                pdf_sin: ((1.0 - sun_prob) * distribution.pdf_cell(i % width, i / width)
-                    / (PI * PI)) as f32,
+                pdf_v: ((1.0 - sun_prob) * distribution.pdf_cell(i % width, i / width) / (4.0 * PI))
+                    as f32,
             })
             .collect();
         Ok(Self {
@@ -302,13 +308,13 @@ impl SunSky {
     /// Map cell (col, row) of an upper-hemisphere direction.
     #[inline]
     fn cell(&self, dir: Vec3) -> (usize, usize) {
-        let theta = dir.z.clamp(-1.0, 1.0).acos();
+        let v = (1.0 - dir.z).max(0.0).sqrt();
         let mut phi = dir.y.atan2(dir.x);
         if phi < 0.0 {
             phi += 2.0 * PI;
         }
         let col = ((phi / (2.0 * PI) * self.width as f64) as usize).min(self.width - 1);
-        let row = ((theta / FRAC_PI_2 * self.height as f64) as usize).min(self.height - 1);
+        let row = ((v * self.height as f64) as usize).min(self.height - 1);
         (col, row)
     }
 
@@ -346,10 +352,10 @@ impl SunSky {
         if dir.z > 0.0 {
             let (col, row) = self.cell(dir);
             let cell = &self.cells[row * self.width + col];
-            let sin_theta = (1.0 - dir.z * dir.z).max(0.0).sqrt();
+            let v = (1.0 - dir.z).max(0.0).sqrt();
             l = cell.radiance.map(f64::from);
-            if sin_theta > 0.0 {
-                p = f64::from(cell.pdf_sin) / sin_theta;
+            if v > 0.0 {
+                p = f64::from(cell.pdf_v) / v;
             }
         }
         self.add_sun(dir, l, p)
@@ -383,11 +389,14 @@ impl SunSky {
         } else {
             let u0 = (u[0] - self.sun_prob) / (1.0 - self.sun_prob);
             let (uv, (col, row), _) = self.distribution.sample([u0, u[1]]);
-            let dir = Vec3::from_spherical(uv[1] * FRAC_PI_2, uv[0] * 2.0 * PI);
+            let v = uv[1];
+            let z = 1.0 - v * v;
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let (sp, cp) = (2.0 * PI * uv[0]).sin_cos();
+            let dir = Vec3::new(r * cp, r * sp, z);
             // The cell is known: no angle computations, the sky's part read directly.
             let cell = &self.cells[row * self.width + col];
-            let sin_theta = (1.0 - dir.z * dir.z).max(0.0).sqrt();
-            let p = if sin_theta > 0.0 { f64::from(cell.pdf_sin) / sin_theta } else { 0.0 };
+            let p = if v > 0.0 { f64::from(cell.pdf_v) / v } else { 0.0 };
             let (l, p) = self.add_sun(dir, cell.radiance.map(f64::from), p);
             (dir, l, p)
         }
