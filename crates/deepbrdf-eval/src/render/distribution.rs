@@ -9,6 +9,9 @@ pub struct Distribution1D {
     cdf: Vec<f64>,
     /// Integral of `func` over [0, 1).
     integral: f64,
+    /// Guide table (Chen's cutpoint method): `guide[k]` is the last bin whose CDF start is
+    /// `<= k / n`, where the search for `u` in `[k/n, (k+1)/n)` starts; O(1) expected steps.
+    guide: Vec<u32>,
 }
 
 impl Distribution1D {
@@ -28,7 +31,16 @@ impl Distribution1D {
             cdf.iter_mut().enumerate().for_each(|(i, c)| *c = i as f64 / n as f64);
         }
         cdf[n] = 1.0;
-        Self { func, cdf, integral }
+        let mut guide = Vec::with_capacity(n);
+        let mut i = 0;
+        for k in 0..n {
+            let u = k as f64 / n as f64;
+            while i + 1 < n && cdf[i + 1] <= u {
+                i += 1;
+            }
+            guide.push(i as u32);
+        }
+        Self { func, cdf, integral, guide }
     }
 
     /// Number of bins.
@@ -60,8 +72,12 @@ impl Distribution1D {
     #[inline]
     pub fn sample(&self, u: f64) -> (f64, usize, f64) {
         let n = self.func.len();
-        // Last index with cdf <= u, among bins 0..n.
-        let i = (self.cdf.partition_point(|&c| c <= u).saturating_sub(1)).min(n - 1);
+        // Last bin with cdf <= u, searched upwards from the guide table's entry.
+        let k = ((u * n as f64) as usize).min(n - 1);
+        let mut i = self.guide[k] as usize;
+        while i + 1 < n && self.cdf[i + 1] <= u {
+            i += 1;
+        }
         let width = self.cdf[i + 1] - self.cdf[i];
         let du = if width > 0.0 { ((u - self.cdf[i]) / width).clamp(0.0, 1.0) } else { 0.5 };
         let x = ((i as f64 + du) / n as f64).min(1.0 - f64::EPSILON);
@@ -142,6 +158,18 @@ mod tests {
         // Density integrates to one: pdf_bin / n summed over bins.
         let total: f64 = (0..4).map(|i| d.pdf_bin(i) / 4.0).sum();
         assert!((total - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn guide_table_agrees_with_binary_search() {
+        let d = Distribution1D::new(vec![0.0, 5.0, 0.0, 0.0, 1.0, 0.1, 0.0, 7.0, 0.0]);
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        for _ in 0..20_000 {
+            let u: f64 = rng.random();
+            let (_, i, _) = d.sample(u);
+            let j = (d.cdf.partition_point(|&c| c <= u) - 1).min(d.len() - 1);
+            assert_eq!(i, j, "u {u}");
+        }
     }
 
     #[test]
