@@ -183,7 +183,8 @@ pub(super) fn load(path: &Path) -> Result<BaselineBasis> {
     let domain = Domain::from_cells(cells).map_err(|e| EvalError::format(path, e.to_string()))?;
     let mapping = if kind == 1 {
         let reference = r.f32s(dim)?;
-        let w = domain.cells().iter().map(|&c| ipca::cos_product(c as usize) as f32).collect();
+        let weights = ipca::cos_weights();
+        let w = domain.cells().iter().map(|&c| weights[c as usize]).collect();
         Mapping::log_relative_from_parts(&domain, reference, w)
             .map_err(|e| EvalError::format(path, e.to_string()))?
     } else {

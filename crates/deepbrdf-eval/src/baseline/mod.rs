@@ -5,11 +5,12 @@ mod artifact;
 mod domain;
 mod mapping;
 
-pub use domain::Domain;
+pub use domain::{grid_mask, Domain};
 pub use mapping::{Mapping, MappingKind};
 
 use crate::error::{EvalError, Result};
-use crate::harness::{Codec, Method};
+use crate::harness::{Codec, Method, TrainingSet};
+use crate::median_reference::MedianReference;
 use crate::pca::LinearBasis;
 use deepbrdf_data::{MerlTable, Progress};
 use std::path::Path;
@@ -34,6 +35,19 @@ impl BaselineBasis {
         k: usize,
         progress: &dyn Progress,
     ) -> Result<Self> {
+        Self::fit_with_reference(name, kind, train, None, k, progress)
+    }
+
+    /// [`BaselineBasis::fit`] with IPCA's median reference already computed (`median` must be
+    /// the per-value median of `train`; computed here when `None`).
+    pub fn fit_with_reference(
+        name: &str,
+        kind: MappingKind,
+        train: &[&MerlTable],
+        median: Option<&MedianReference>,
+        k: usize,
+        progress: &dyn Progress,
+    ) -> Result<Self> {
         if train.len() < 2 {
             return Err(EvalError::Invalid(format!(
                 "{name} needs at least 2 training tables, got {}",
@@ -43,10 +57,13 @@ impl BaselineBasis {
         let domain = Domain::common(train)?;
         let mapping = match kind {
             MappingKind::Log => Mapping::Log,
-            MappingKind::LogRelative => {
-                let median = crate::median_reference::MedianReference::from_tables(train)?;
-                Mapping::log_relative(&domain, median.values())?
-            }
+            MappingKind::LogRelative => match median {
+                Some(median) => Mapping::log_relative(&domain, median.values())?,
+                None => {
+                    let median = MedianReference::from_tables(train)?;
+                    Mapping::log_relative(&domain, median.values())?
+                }
+            },
         };
         let rows: Vec<Vec<f32>> = train.iter().map(|t| mapping.forward(&domain, t)).collect();
         let refs: Vec<&[f32]> = rows.iter().map(|r| r.as_slice()).collect();
@@ -184,6 +201,12 @@ impl BaselineMethod {
     ) -> Result<BaselineBasis> {
         BaselineBasis::fit(&self.name, self.kind, train, k, progress)
     }
+
+    /// One basis at the largest of `ks`, each codec a truncation of it.
+    fn nested_codecs(basis: BaselineBasis, ks: &[usize]) -> Result<Vec<Box<dyn Codec>>> {
+        let basis = Arc::new(basis);
+        ks.iter().map(|&k| Ok(Box::new(basis.codec(k)?) as Box<dyn Codec>)).collect()
+    }
 }
 
 impl Method for BaselineMethod {
@@ -210,17 +233,37 @@ impl Method for BaselineMethod {
         ks: &[usize],
         progress: &dyn Progress,
     ) -> Result<Vec<Box<dyn Codec>>> {
-        let k_max =
-            ks.iter().copied().max().ok_or_else(|| EvalError::Invalid("no k given".into()))?;
-        let basis = Arc::new(self.fit_basis(train, k_max, progress)?);
-        ks.iter().map(|&k| Ok(Box::new(basis.codec(k)?) as Box<dyn Codec>)).collect()
+        let k_max = max_k(ks)?;
+        Self::nested_codecs(self.fit_basis(train, k_max, progress)?, ks)
     }
+
+    /// As [`Method::fit_ks`], reusing the fold's median reference for IPCA.
+    fn fit_fold(
+        &self,
+        train: &TrainingSet<'_>,
+        ks: &[usize],
+        progress: &dyn Progress,
+    ) -> Result<Vec<Box<dyn Codec>>> {
+        let basis = BaselineBasis::fit_with_reference(
+            &self.name,
+            self.kind,
+            train.tables,
+            Some(train.reference),
+            max_k(ks)?,
+            progress,
+        )?;
+        Self::nested_codecs(basis, ks)
+    }
+}
+
+fn max_k(ks: &[usize]) -> Result<usize> {
+    ks.iter().copied().max().ok_or_else(|| EvalError::Invalid("no k given".into()))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testing::synthetic_set;
+    use crate::testing::{sparse_set, synthetic_set};
     use deepbrdf_data::merl::CELLS;
     use deepbrdf_data::Silent;
 
@@ -228,7 +271,7 @@ mod tests {
     fn max_weighted_error(a: &MerlTable, b: &MerlTable, domain: &Domain) -> f64 {
         let mut worst = 0f64;
         for &cell in domain.cells() {
-            let w = crate::ipca::cos_product(cell as usize);
+            let w = f64::from(crate::ipca::cos_weights()[cell as usize]);
             for c in 0..3 {
                 let i = c * CELLS + cell as usize;
                 worst = worst.max((f64::from(a.values()[i]) - f64::from(b.values()[i])).abs() * w);
@@ -243,7 +286,7 @@ mod tests {
         let refs: Vec<&MerlTable> = tables.iter().collect();
         let domain = Domain::common(&refs).unwrap();
         assert_eq!(domain.cells().len(), tables[0].valid_cells());
-        let median = crate::median_reference::MedianReference::from_tables(&refs).unwrap();
+        let median = MedianReference::from_tables(&refs).unwrap();
         for mapping in [Mapping::Log, Mapping::log_relative(&domain, median.values()).unwrap()] {
             let back = mapping.inverse(&domain, &mapping.forward(&domain, &tables[2])).unwrap();
             assert_eq!(back.mask(), tables[2].mask());
@@ -259,7 +302,7 @@ mod tests {
 
     #[test]
     fn full_rank_codecs_reproduce_their_training_tables() {
-        let (names, tables) = synthetic_set(5);
+        let (names, tables) = sparse_set(5);
         let refs: Vec<&MerlTable> = tables.iter().collect();
         for method in [crate::pca::Pca::method(), crate::ipca::Ipca::method()] {
             let codecs = method.fit_ks(&refs, &names, &[1, 4], &Silent).unwrap();
@@ -279,7 +322,7 @@ mod tests {
 
     #[test]
     fn artifact_round_trips_and_rejects_corruption() {
-        let (_, tables) = synthetic_set(4);
+        let (_, tables) = sparse_set(4);
         let refs: Vec<&MerlTable> = tables.iter().collect();
         let dir = tempfile::tempdir().unwrap();
         for method in [crate::pca::Pca::method(), crate::ipca::Ipca::method()] {
