@@ -1,7 +1,7 @@
 //! `deepbrdf-data`: measured BRDF data for DeepBRDF (Hu et al., CGF 2020, §3.1).
+pub mod augment;
 pub mod bundled;
 pub mod cache;
-pub mod augment;
 pub mod error;
 mod files;
 pub mod layout;
