@@ -1,5 +1,6 @@
 //! `deepbrdf-data`: measured BRDF data for DeepBRDF (Hu et al., CGF 2020, §3.1).
 pub mod error;
+pub mod fetch;
 pub mod merl;
 pub mod progress;
 
