@@ -3,6 +3,7 @@ pub mod augment;
 pub mod bundled;
 pub mod cache;
 pub mod error;
+pub mod fetch;
 mod files;
 pub mod layout;
 pub mod mapping;
