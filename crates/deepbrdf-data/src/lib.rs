@@ -1,6 +1,13 @@
 //! `deepbrdf-data`: measured BRDF data for DeepBRDF (Hu et al., CGF 2020, §3.1).
+pub mod bundled;
+pub mod cache;
+pub mod augment;
 pub mod error;
+mod files;
+pub mod layout;
+pub mod mapping;
 pub mod merl;
+pub mod nbrdf;
 pub mod progress;
 
 pub use error::{DataError, Result};

@@ -7,6 +7,7 @@ pub mod harness;
 pub mod ipca;
 mod median_reference;
 pub mod pca;
+pub mod render;
 #[cfg(test)]
 mod testing;
 

@@ -1,7 +1,9 @@
-//! The MERL BRDF format (Matusik et al. 2003): grid, table.
+//! The MERL BRDF format (Matusik et al. 2003): grid, table, file I/O.
 pub mod grid;
+pub mod io;
 pub mod table;
 
+pub use io::{read_merl, write_merl, MerlFile};
 pub use table::{
     cell_coords, cell_index, MerlTable, CELLS, INVALID_VALUE, MERL_SCALE, N_PHI_D, N_THETA_D,
     N_THETA_H, VALUES,

@@ -1,0 +1,99 @@
+//! Careful file access shared by the binary formats of this crate: reading a whole file after
+//! checking what it is, and atomic writes (temporary file in the same directory, then rename), so
+//! that a crash or a full disk never leaves a half-written file under its final name.
+
+use crate::error::{DataError, Result};
+use std::fs::File;
+use std::io::{Read, Write};
+use std::path::Path;
+
+/// Opens `path` for reading and returns the file with its length in bytes. A missing path or a
+/// directory is an error naming the path.
+pub(crate) fn open_regular(path: &Path) -> Result<(File, u64)> {
+    let meta = std::fs::metadata(path).map_err(|e| DataError::io(path, e))?;
+    if meta.is_dir() {
+        return Err(DataError::format(path, "is a directory, not a file"));
+    }
+    let file = File::open(path).map_err(|e| DataError::io(path, e))?;
+    let len = file.metadata().map_err(|e| DataError::io(path, e))?.len();
+    Ok((file, len))
+}
+
+/// Reads exactly `len` bytes from `file` (whose length was checked by the caller) and fails if
+/// the file turns out shorter, or longer (it changed since it was checked).
+pub(crate) fn read_exactly(file: &mut File, path: &Path, len: usize) -> Result<Vec<u8>> {
+    let mut bytes = vec![0u8; len];
+    file.read_exact(&mut bytes).map_err(|e| {
+        if e.kind() == std::io::ErrorKind::UnexpectedEof {
+            DataError::format(path, format!("truncated: fewer than {len} bytes"))
+        } else {
+            DataError::io(path, e)
+        }
+    })?;
+    let mut extra = [0u8; 1];
+    match file.read(&mut extra) {
+        Ok(0) => Ok(bytes),
+        Ok(_) => Err(DataError::format(path, format!("trailing bytes after the expected {len}"))),
+        Err(e) => Err(DataError::io(path, e)),
+    }
+}
+
+/// Writes `bytes` to `path` atomically: a temporary file in the same directory is written,
+/// flushed to disk and renamed over `path`. On failure `path` is untouched and the temporary file
+/// is removed.
+pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if path.is_dir() {
+        return Err(DataError::format(path, "is a directory; refusing to replace it by a file"));
+    }
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".deepbrdf-")
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map_err(|e| DataError::io(dir, e))?;
+    tmp.write_all(bytes).map_err(|e| DataError::io(tmp.path(), e))?;
+    tmp.as_file().sync_all().map_err(|e| DataError::io(tmp.path(), e))?;
+    tmp.persist(path).map_err(|e| DataError::io(path, e.error))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    type TestResult = std::result::Result<(), Box<dyn std::error::Error>>;
+
+    #[test]
+    fn atomic_write_replaces_and_leaves_no_temporary() -> TestResult {
+        let dir = tempfile::tempdir()?;
+        let path = dir.path().join("a.bin");
+        write_atomic(&path, b"first")?;
+        write_atomic(&path, b"second")?;
+        assert_eq!(std::fs::read(&path)?, b"second");
+        let names: Vec<_> =
+            std::fs::read_dir(dir.path())?.filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
+        assert_eq!(names, vec![std::ffi::OsString::from("a.bin")]);
+        Ok(())
+    }
+
+    #[test]
+    fn write_into_missing_directory_names_it() {
+        let err = write_atomic(Path::new("/nonexistent-deepbrdf-dir/x.bin"), b"x");
+        let msg = err.err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(msg.contains("/nonexistent-deepbrdf-dir"), "{msg}");
+    }
+
+    #[test]
+    fn directory_and_missing_path_are_errors_naming_the_path() -> TestResult {
+        let dir = tempfile::tempdir()?;
+        let msg = open_regular(dir.path()).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(msg.contains("directory") && msg.contains(&*dir.path().to_string_lossy()), "{msg}");
+        let missing = dir.path().join("missing.bin");
+        let msg = open_regular(&missing).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(msg.contains("missing.bin"), "{msg}");
+        Ok(())
+    }
+}

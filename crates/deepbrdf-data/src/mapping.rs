@@ -1,0 +1,488 @@
+//! The log-relative mapping of eq. (1) (Hu et al. 2020, §3.1, after Nielsen et al. 2015):
+//! `rho' = ln((rho + eps) / (rho_ref + eps) + 1)` with `eps = 1e-3`, where the reference BRDF
+//! `rho_ref` is the median over a training set of each value, i.e. of each
+//! (theta_h, theta_d, phi_d) cell and colour channel ([`MedianReference`]).
+//!
+//! The mapping compresses the high dynamic range of measured BRDFs for the network; its inverse
+//! ([`MedianReference::unmap`]) is exact up to f32 rounding of the mapped value.
+//!
+//! A reference can be saved and reloaded ([`MedianReference::save`] / [`MedianReference::load`])
+//! in a small checksummed binary format, so a trained model is always used with the reference it
+//! was trained with:
+//!
+//! | bytes            | content                                               |
+//! |------------------|-------------------------------------------------------|
+//! | 8                | magic `DBRDFMED`                                      |
+//! | 4                | format version, u32 little-endian (= 1)               |
+//! | 8                | number of values, u64 little-endian (= [`VALUES`])    |
+//! | 4 x values       | the values, f32 little-endian, channel-major MERL order |
+//! | 32               | SHA-256 of all preceding bytes                        |
+
+use crate::error::{DataError, Result};
+use crate::files::{open_regular, read_exactly, write_atomic};
+use crate::merl::{MerlTable, CELLS, INVALID_VALUE, VALUES};
+use rayon::prelude::*;
+use sha2::{Digest, Sha256};
+use std::io::Read;
+use std::path::Path;
+
+/// eps of eq. (1): a small constant that avoids division by zero.
+pub const EPSILON: f64 = 1e-3;
+
+/// Magic bytes that open a saved [`MedianReference`].
+const MAGIC: &[u8; 8] = b"DBRDFMED";
+/// Version of the saved format.
+const VERSION: u32 = 1;
+/// Bytes before the values: magic, version, length.
+const HEADER_BYTES: usize = 8 + 4 + 8;
+/// Bytes of the SHA-256 checksum at the end.
+const CHECKSUM_BYTES: usize = 32;
+/// Size of a valid saved reference.
+const FILE_BYTES: usize = HEADER_BYTES + 4 * VALUES + CHECKSUM_BYTES;
+/// Values per parallel work item.
+const CHUNK: usize = 16 * 1024;
+
+/// Eq. (1) for one value: `ln((rho + eps) / (rho_ref + eps) + 1)`.
+#[inline]
+pub fn log_relative(rho: f64, rho_ref: f64) -> f64 {
+    ((rho + EPSILON) / (rho_ref + EPSILON)).ln_1p()
+}
+
+/// The inverse of [`log_relative`]: `(exp(mapped) - 1) (rho_ref + eps) - eps`, not clamped.
+#[inline]
+pub fn inverse_log_relative(mapped: f64, rho_ref: f64) -> f64 {
+    mapped.exp_m1() * (rho_ref + EPSILON) - EPSILON
+}
+
+/// The reference BRDF of eq. (1): one non-negative value per cell and channel ([`VALUES`] values,
+/// channel-major, each channel in MERL's file order), the median over a training set.
+#[derive(Clone, PartialEq)]
+pub struct MedianReference {
+    values: Vec<f32>,
+}
+
+impl std::fmt::Debug for MedianReference {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "MedianReference {{ {} values }}", self.values.len())
+    }
+}
+
+impl MedianReference {
+    /// The per-value median over `tables` (§3.1: "the median value for each
+    /// (theta_h, theta_d, phi_d), over the entire MERL dataset"), computed in parallel.
+    ///
+    /// For each cell and channel, the median is taken over the tables in which the cell is valid
+    /// ([`MerlTable::is_valid`]); for an even count it is the mean of the two middle values. A
+    /// cell that is valid in no table gets the reference 0 (it is never mapped: invalid cells map
+    /// to 0 whatever the reference).
+    pub fn from_tables(tables: &[&MerlTable]) -> Result<Self> {
+        if tables.is_empty() {
+            return Err(DataError::Invalid("the median reference needs at least one table".into()));
+        }
+        let per_cell: Vec<[f32; 3]> = (0..CELLS)
+            .into_par_iter()
+            .with_min_len(1024)
+            .map_init(
+                || [Vec::with_capacity(tables.len()), Vec::new(), Vec::new()],
+                |bufs, cell| {
+                    for b in bufs.iter_mut() {
+                        b.clear();
+                    }
+                    for t in tables {
+                        if t.is_valid(cell) {
+                            let v = t.values();
+                            for (c, b) in bufs.iter_mut().enumerate() {
+                                b.push(v[c * CELLS + cell]);
+                            }
+                        }
+                    }
+                    let mut out = [0f32; 3];
+                    for (o, b) in out.iter_mut().zip(bufs.iter_mut()) {
+                        *o = median(b);
+                    }
+                    out
+                },
+            )
+            .collect();
+        let mut values = vec![0f32; VALUES];
+        for (c, channel) in values.chunks_exact_mut(CELLS).enumerate() {
+            for (v, rgb) in channel.iter_mut().zip(&per_cell) {
+                *v = rgb[c];
+            }
+        }
+        Ok(Self { values })
+    }
+
+    /// Wraps precomputed reference values: [`VALUES`] long, finite and non-negative.
+    pub fn from_values(values: Vec<f32>) -> Result<Self> {
+        if values.len() != VALUES {
+            return Err(DataError::Invalid(format!(
+                "a median reference has {VALUES} values, got {}",
+                values.len()
+            )));
+        }
+        if let Some(i) = values.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
+            return Err(DataError::Invalid(format!(
+                "median reference value {i} is {} (must be finite and non-negative)",
+                values[i]
+            )));
+        }
+        Ok(Self { values })
+    }
+
+    /// The reference values, [`VALUES`] long, channel-major MERL order.
+    pub fn values(&self) -> &[f32] {
+        &self.values
+    }
+
+    /// Eq. (1) applied to every value of `table`: [`VALUES`] mapped values, channel-major MERL
+    /// order. Values of invalid cells map to 0.0 (the paper sets invalid entries to zero, §3.2).
+    pub fn map(&self, table: &MerlTable) -> Vec<f32> {
+        let mut out = vec![0f32; VALUES];
+        let rho = table.values();
+        out.par_chunks_mut(CHUNK).enumerate().for_each(|(b, chunk)| {
+            let start = b * CHUNK;
+            for (k, o) in chunk.iter_mut().enumerate() {
+                let i = start + k;
+                if table.is_valid(i % CELLS) {
+                    *o = log_relative(f64::from(rho[i]), f64::from(self.values[i])) as f32;
+                }
+            }
+        });
+        out
+    }
+
+    /// The inverse of [`Self::map`]: reflectance from `mapped` values ([`VALUES`], channel-major
+    /// MERL order) on the cells where `mask` ([`CELLS`] entries, MERL order) is true. Results are
+    /// clamped to >= 0 (a negative value would mark the cell invalid); cells outside the mask get
+    /// [`INVALID_VALUE`]. Fails on wrong lengths, a non-finite mapped value in a valid cell, or a
+    /// mapped value so large that the reflectance overflows f32.
+    pub fn unmap(&self, mapped: &[f32], mask: &[bool]) -> Result<MerlTable> {
+        if mapped.len() != VALUES {
+            return Err(DataError::Invalid(format!(
+                "unmap needs {VALUES} mapped values, got {}",
+                mapped.len()
+            )));
+        }
+        if mask.len() != CELLS {
+            return Err(DataError::Invalid(format!(
+                "unmap needs a mask of {CELLS} cells, got {}",
+                mask.len()
+            )));
+        }
+        let mut out = vec![INVALID_VALUE; VALUES];
+        out.par_chunks_mut(CHUNK).enumerate().for_each(|(b, chunk)| {
+            let start = b * CHUNK;
+            for (k, o) in chunk.iter_mut().enumerate() {
+                let i = start + k;
+                if mask[i % CELLS] {
+                    let rho = inverse_log_relative(f64::from(mapped[i]), f64::from(self.values[i]));
+                    // NaN stays NaN (max would hide it) and is reported below.
+                    *o = if rho < 0.0 { 0.0 } else { rho as f32 };
+                }
+            }
+        });
+        if let Some(i) = out.iter().position(|v| !v.is_finite()) {
+            return Err(DataError::Invalid(format!(
+                "mapped value {i} ({}) has no finite f32 reflectance",
+                mapped[i]
+            )));
+        }
+        MerlTable::from_values(out)
+    }
+
+    /// Saves the reference to `path` (format in the module documentation), atomically.
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
+        let mut bytes = Vec::with_capacity(FILE_BYTES);
+        bytes.extend_from_slice(MAGIC);
+        bytes.extend_from_slice(&VERSION.to_le_bytes());
+        bytes.extend_from_slice(&(self.values.len() as u64).to_le_bytes());
+        for v in &self.values {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+        let digest = Sha256::digest(&bytes);
+        bytes.extend_from_slice(&digest);
+        write_atomic(path.as_ref(), &bytes)
+    }
+
+    /// Loads a reference saved by [`Self::save`]. Every malformed file (empty, truncated, other
+    /// magic, version or length, trailing bytes, checksum mismatch, invalid values) is an error
+    /// naming the file; nothing is allocated before the file's size has been checked.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let (mut file, len) = open_regular(path)?;
+        if len == 0 {
+            return Err(DataError::format(path, "empty file, expected a median reference"));
+        }
+        let mut header = [0u8; HEADER_BYTES];
+        let got = read_prefix(&mut file, path, &mut header)?;
+        if got < MAGIC.len() || &header[..8] != MAGIC {
+            return Err(DataError::format(
+                path,
+                "not a median reference file (it does not start with DBRDFMED)",
+            ));
+        }
+        if got < HEADER_BYTES {
+            return Err(DataError::format(path, format!("truncated: {len} bytes")));
+        }
+        let version = u32::from_le_bytes([header[8], header[9], header[10], header[11]]);
+        if version != VERSION {
+            return Err(DataError::format(
+                path,
+                format!("median reference format version {version}, this build reads {VERSION}"),
+            ));
+        }
+        let mut n = [0u8; 8];
+        n.copy_from_slice(&header[12..20]);
+        let n = u64::from_le_bytes(n);
+        if n != VALUES as u64 {
+            return Err(DataError::format(
+                path,
+                format!("holds {n} values, a median reference has {VALUES}"),
+            ));
+        }
+        if len < FILE_BYTES as u64 {
+            return Err(DataError::format(
+                path,
+                format!("truncated: {len} bytes, expected {FILE_BYTES}"),
+            ));
+        }
+        if len > FILE_BYTES as u64 {
+            return Err(DataError::format(
+                path,
+                format!(
+                    "{} trailing bytes after the expected {FILE_BYTES}",
+                    len - FILE_BYTES as u64
+                ),
+            ));
+        }
+        let rest = read_exactly(&mut file, path, FILE_BYTES - HEADER_BYTES)?;
+        let (body, checksum) = rest.split_at(rest.len() - CHECKSUM_BYTES);
+        let mut hasher = Sha256::new();
+        hasher.update(header);
+        hasher.update(body);
+        if hasher.finalize().as_slice() != checksum {
+            return Err(DataError::format(path, "checksum mismatch: the file is corrupted"));
+        }
+        let values: Vec<f32> =
+            body.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+        Self::from_values(values).map_err(|e| DataError::format(path, e.to_string()))
+    }
+}
+
+/// Reads up to `buf.len()` bytes from the start of `file`; returns how many were read.
+fn read_prefix(file: &mut std::fs::File, path: &Path, buf: &mut [u8]) -> Result<usize> {
+    let mut got = 0;
+    while got < buf.len() {
+        match file.read(&mut buf[got..]) {
+            Ok(0) => break,
+            Ok(n) => got += n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(DataError::io(path, e)),
+        }
+    }
+    Ok(got)
+}
+
+/// Median of `values` (reordered in place); the mean of the two middle values for an even count;
+/// 0 for none.
+fn median(values: &mut [f32]) -> f32 {
+    let n = values.len();
+    if n == 0 {
+        return 0.0;
+    }
+    values.sort_unstable_by(f32::total_cmp);
+    if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        (0.5 * (f64::from(values[n / 2 - 1]) + f64::from(values[n / 2]))) as f32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::merl::grid::cell_is_valid;
+    use crate::merl::{cell_coords, cell_index};
+
+    type TestResult = std::result::Result<(), Box<dyn std::error::Error>>;
+
+    /// A table whose valid values are `f(channel, cell)`; invalid cells as in the MERL grid.
+    fn table_with(f: impl Fn(usize, usize) -> f32) -> MerlTable {
+        let mut values = vec![INVALID_VALUE; VALUES];
+        for cell in 0..CELLS {
+            let (h, d, p) = cell_coords(cell);
+            if cell_is_valid(h, d, p) {
+                for c in 0..3 {
+                    values[c * CELLS + cell] = f(c, cell);
+                }
+            }
+        }
+        MerlTable::from_values(values).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    #[test]
+    fn median_of_known_sets() {
+        assert_eq!(median(&mut []), 0.0);
+        assert_eq!(median(&mut [3.0]), 3.0);
+        assert_eq!(median(&mut [5.0, 1.0, 3.0]), 3.0);
+        assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 2.5);
+        assert_eq!(median(&mut [7.0, 7.0, 1.0, 100.0, 0.0]), 7.0);
+    }
+
+    #[test]
+    fn reference_is_the_per_value_median_of_valid_values() -> TestResult {
+        // Four tables with values 1, 2, 3, 10 (times a per-value pattern); in the fourth one,
+        // one cell is invalid so its median is over three values.
+        let special = cell_index(10, 20, 90);
+        let tables: Vec<MerlTable> = [1.0f32, 2.0, 3.0, 10.0]
+            .iter()
+            .enumerate()
+            .map(|(t, s)| {
+                let mut table = table_with(|c, cell| s * (1.0 + c as f32 + (cell % 7) as f32));
+                if t == 3 {
+                    for c in 0..3 {
+                        table.values_mut()[c * CELLS + special] = INVALID_VALUE;
+                    }
+                }
+                table
+            })
+            .collect();
+        let refs: Vec<&MerlTable> = tables.iter().collect();
+        let reference = MedianReference::from_tables(&refs)?;
+        let v = reference.values();
+        let cell = cell_index(5, 5, 5);
+        for c in 0..3 {
+            let pattern = 1.0 + c as f32 + (cell % 7) as f32;
+            // Even count: mean of 2 and 3 times the pattern.
+            assert_eq!(v[c * CELLS + cell], 2.5 * pattern);
+            let pattern = 1.0 + c as f32 + (special % 7) as f32;
+            // Odd count (10 excluded as invalid): 2 times the pattern.
+            assert_eq!(v[c * CELLS + special], 2.0 * pattern);
+        }
+        // A cell invalid everywhere (theta_d near 90 degrees, phi_d = 0) gets reference 0.
+        let invalid = cell_index(60, 89, 0);
+        assert!(!cell_is_valid(60, 89, 0));
+        assert_eq!(v[invalid], 0.0);
+        assert!(MedianReference::from_tables(&[]).is_err());
+        Ok(())
+    }
+
+    #[test]
+    fn map_is_eq1_and_unmap_is_its_exact_inverse() -> TestResult {
+        // Values spanning the HDR range of measured BRDFs, 1e-5 .. 1e4 (1/sr).
+        let table = table_with(|c, cell| {
+            let t = ((cell * 7919 + c * 104729) % 100_003) as f32 / 100_003.0;
+            10f32.powf(-5.0 + 9.0 * t)
+        });
+        let reference = MedianReference::from_values(
+            (0..VALUES).map(|i| ((i * 31) % 1000) as f32 / 100.0).collect(),
+        )?;
+        let mapped = reference.map(&table);
+        let mask = table.mask();
+        // Eq. (1) checked on a few values against the formula written out.
+        for i in [0usize, 12345, CELLS + 777_777, 2 * CELLS + 1_000_000] {
+            let cell = i % CELLS;
+            if mask[cell] {
+                let (rho, r) = (table.values()[i] as f64, reference.values()[i] as f64);
+                let expect = ((rho + 0.001) / (r + 0.001) + 1.0).ln();
+                assert!((mapped[i] as f64 - expect).abs() <= 1e-6 * expect, "{i}");
+            } else {
+                assert_eq!(mapped[i], 0.0);
+            }
+        }
+        let back = reference.unmap(&mapped, &mask)?;
+        assert_eq!(back.mask(), mask);
+        for i in 0..VALUES {
+            if !mask[i % CELLS] {
+                assert_eq!(back.values()[i], INVALID_VALUE);
+                continue;
+            }
+            let (rho, r, y) =
+                (table.values()[i] as f64, reference.values()[i] as f64, mapped[i] as f64);
+            let got = back.values()[i] as f64;
+            // The only error is the f32 rounding of the mapped value y (relative 2^-24) and of
+            // the result: d rho = (rho_ref + eps) e^y dy = (rho + rho_ref + 2 eps) dy.
+            let tol = f64::from(f32::EPSILON) * ((rho + r + 2.0 * EPSILON) * y.max(1.0) + rho);
+            assert!((got - rho).abs() <= tol, "value {i}: {got} vs {rho} (tol {tol})");
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn unmap_clamps_to_zero_and_rejects_bad_input() -> TestResult {
+        let reference = MedianReference::from_values(vec![0.5; VALUES])?;
+        let mask = vec![true; CELLS];
+        let table = reference.unmap(&vec![-3.0; VALUES], &mask)?;
+        assert!(table.values().iter().all(|v| *v == 0.0));
+        assert!(reference.unmap(&vec![0.0; VALUES - 1], &mask).is_err());
+        assert!(reference.unmap(&vec![0.0; VALUES], &mask[1..]).is_err());
+        let mut bad = vec![0.0; VALUES];
+        bad[17] = f32::NAN;
+        assert!(reference.unmap(&bad, &mask).is_err());
+        bad[17] = 200.0; // e^200 overflows f32
+        assert!(reference.unmap(&bad, &mask).is_err());
+        let mut masked = mask.clone();
+        masked[17] = false;
+        assert_eq!(reference.unmap(&bad, &masked)?.values()[17], INVALID_VALUE);
+        Ok(())
+    }
+
+    #[test]
+    fn from_values_rejects_bad_values() {
+        assert!(MedianReference::from_values(vec![0.0; 10]).is_err());
+        let mut v = vec![0.0; VALUES];
+        v[3] = -1.0;
+        assert!(MedianReference::from_values(v.clone()).is_err());
+        v[3] = f32::INFINITY;
+        assert!(MedianReference::from_values(v).is_err());
+    }
+
+    #[test]
+    fn save_load_round_trip_and_corruption_errors() -> TestResult {
+        let dir = tempfile::tempdir()?;
+        let path = dir.path().join("median.bin");
+        let reference =
+            MedianReference::from_values((0..VALUES).map(|i| (i % 977) as f32 * 0.013).collect())?;
+        reference.save(&path)?;
+        assert_eq!(MedianReference::load(&path)?, reference);
+        let good = std::fs::read(&path)?;
+        assert_eq!(good.len(), FILE_BYTES);
+
+        let check = |bytes: &[u8], what: &str| -> TestResult {
+            let p = dir.path().join("bad.bin");
+            std::fs::write(&p, bytes)?;
+            let msg = MedianReference::load(&p).err().map(|e| e.to_string()).unwrap_or_default();
+            assert!(msg.contains("bad.bin") && msg.contains(what), "{what}: {msg}");
+            Ok(())
+        };
+        check(&[], "empty")?;
+        check(b"hello world, not a reference", "DBRDFMED")?;
+        check(&good[..15], "truncated")?;
+        check(&good[..good.len() - 1], "truncated")?;
+        let mut long = good.clone();
+        long.push(0);
+        check(&long, "trailing")?;
+        let mut flipped = good.clone();
+        flipped[HEADER_BYTES + 1000] ^= 1;
+        check(&flipped, "checksum")?;
+        let mut version = good.clone();
+        version[8] = 9;
+        check(&version, "version 9")?;
+        let mut huge = good.clone();
+        huge[12..20].copy_from_slice(&(1u64 << 40).to_le_bytes());
+        check(&huge, "1099511627776 values")?;
+        // A checksummed file with a NaN inside is still rejected.
+        let mut nan = good[..good.len() - CHECKSUM_BYTES].to_vec();
+        nan[HEADER_BYTES..HEADER_BYTES + 4].copy_from_slice(&f32::NAN.to_le_bytes());
+        let digest = Sha256::digest(&nan);
+        nan.extend_from_slice(&digest);
+        check(&nan, "value 0")?;
+        let msg = MedianReference::load(dir.path()).err().map(|e| e.to_string());
+        assert!(msg.unwrap_or_default().contains("directory"));
+        let msg =
+            MedianReference::load(dir.path().join("missing.bin")).err().map(|e| e.to_string());
+        assert!(msg.unwrap_or_default().contains("missing.bin"));
+        Ok(())
+    }
+}
