@@ -10,8 +10,8 @@ pub use mapping::{Mapping, MappingKind};
 
 use crate::error::{EvalError, Result};
 use crate::harness::{Codec, Method, TrainingSet};
-use crate::median_reference::MedianReference;
 use crate::pca::LinearBasis;
+use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::{MerlTable, Progress};
 use std::path::Path;
 use std::sync::Arc;
