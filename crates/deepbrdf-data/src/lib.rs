@@ -2,6 +2,7 @@
 pub mod augment;
 pub mod bundled;
 pub mod cache;
+pub mod dataset;
 pub mod error;
 pub mod fetch;
 mod files;
@@ -10,6 +11,7 @@ pub mod mapping;
 pub mod merl;
 pub mod nbrdf;
 pub mod progress;
+pub mod summary;
 
 pub use error::{DataError, Result};
 pub use merl::MerlTable;
