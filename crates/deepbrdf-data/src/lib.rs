@@ -6,6 +6,7 @@ pub mod layout;
 pub mod mapping;
 pub mod merl;
 pub mod progress;
+pub mod testing;
 
 pub use error::{DataError, Result};
 pub use merl::MerlTable;
