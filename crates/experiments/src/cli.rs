@@ -17,4 +17,6 @@ pub struct Cli {
 pub enum Command {
     /// List the compute devices compiled into this binary.
     Devices(commands::devices::Args),
+    /// Benchmarks that print speed numbers.
+    Bench(commands::bench::Args),
 }
