@@ -1,10 +1,14 @@
 //! `deepbrdf-data`: measured BRDF data for DeepBRDF (Hu et al., CGF 2020, §3.1).
 pub mod augment;
+pub mod bundled;
+pub mod cache;
 pub mod error;
+pub mod fetch;
 mod files;
 pub mod layout;
 pub mod mapping;
 pub mod merl;
+pub mod nbrdf;
 pub mod progress;
 pub mod testing;
 

@@ -10,7 +10,9 @@
 //! components exactly as in [`crate::pca`].
 
 use crate::baseline::{BaselineMethod, MappingKind};
-use deepbrdf_data::merl::{cell_coords, grid};
+use deepbrdf_data::merl::{cell_coords, grid, CELLS};
+use rayon::prelude::*;
+use std::sync::OnceLock;
 
 /// eps of the log-relative mapping (Nielsen et al. 2015; the same 0.001 as the paper's eq. 1).
 pub const EPSILON: f64 = 1e-3;
@@ -40,6 +42,14 @@ pub fn cos_product(cell: usize) -> f64 {
     (a - b) * (a + b)
 }
 
+/// [`cos_product`] of every cell (MERL order, [`CELLS`] long, negative on invalid cells) as f32,
+/// computed once per process (in parallel) and shared: mappings, measures and tests read it
+/// instead of re-evaluating the trigonometry per cell.
+pub fn cos_weights() -> &'static [f32] {
+    static WEIGHTS: OnceLock<Vec<f32>> = OnceLock::new();
+    WEIGHTS.get_or_init(|| (0..CELLS).into_par_iter().map(|c| cos_product(c) as f32).collect())
+}
+
 /// IPCA as a harness method.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Ipca;
@@ -54,7 +64,7 @@ impl Ipca {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use deepbrdf_data::merl::{cell_index, CELLS};
+    use deepbrdf_data::merl::cell_index;
 
     #[test]
     fn mapping_round_trips() {
@@ -84,6 +94,7 @@ mod tests {
         for cell in (0..CELLS).step_by(97) {
             let (i, j, k) = cell_coords(cell);
             assert_eq!(cos_product(cell) > 0.0, grid::cell_is_valid(i, j, k), "cell {cell}");
+            assert_eq!(cos_weights()[cell], cos_product(cell) as f32);
         }
     }
 }

@@ -5,8 +5,8 @@ pub mod error;
 pub mod figures;
 pub mod harness;
 pub mod ipca;
-mod median_reference;
 pub mod pca;
+pub mod render;
 #[cfg(test)]
 mod testing;
 

@@ -12,6 +12,25 @@
 use crate::error::{EvalError, Result};
 use deepbrdf_data::merl::{cell_coords, grid, CELLS};
 use deepbrdf_data::MerlTable;
+use rayon::prelude::*;
+use std::sync::OnceLock;
+
+/// Cells per parallel work item.
+const CHUNK: usize = 16 * 1024;
+
+/// [`grid::cell_is_valid`] of every cell, evaluated once per process.
+pub fn grid_mask() -> &'static [bool] {
+    static MASK: OnceLock<Vec<bool>> = OnceLock::new();
+    MASK.get_or_init(|| {
+        (0..CELLS)
+            .into_par_iter()
+            .map(|c| {
+                let (h, d, p) = cell_coords(c);
+                grid::cell_is_valid(h, d, p)
+            })
+            .collect()
+    })
+}
 
 /// Valid cells shared by a set of tables, in increasing MERL order.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -22,12 +41,15 @@ pub struct Domain {
 impl Domain {
     /// Cells valid in all `tables` and on the grid ([`grid::cell_is_valid`]).
     pub fn common(tables: &[&MerlTable]) -> Result<Self> {
-        let cells: Vec<u32> = (0..CELLS)
-            .filter(|&c| {
-                let (h, d, p) = cell_coords(c);
-                grid::cell_is_valid(h, d, p) && tables.iter().all(|t| t.is_valid(c))
+        let grid = grid_mask();
+        let cells: Vec<u32> = grid
+            .par_chunks(CHUNK)
+            .enumerate()
+            .flat_map_iter(|(b, chunk)| {
+                (b * CHUNK..).zip(chunk).filter_map(|(c, &on_grid)| {
+                    (on_grid && tables.iter().all(|t| t.is_valid(c))).then_some(c as u32)
+                })
             })
-            .map(|c| c as u32)
             .collect();
         if cells.is_empty() {
             return Err(EvalError::Invalid("the tables share no valid cell".into()));
@@ -62,5 +84,12 @@ impl Domain {
     #[inline]
     pub fn row_index(&self, c: usize, m: usize) -> usize {
         c * self.cells.len() + m
+    }
+
+    /// The range of domain positions `m` whose cells lie in `cells` (a range of cell indices).
+    pub fn positions_in(&self, cells: std::ops::Range<usize>) -> std::ops::Range<usize> {
+        let lo = self.cells.partition_point(|&c| (c as usize) < cells.start);
+        let hi = self.cells.partition_point(|&c| (c as usize) < cells.end);
+        lo..hi
     }
 }

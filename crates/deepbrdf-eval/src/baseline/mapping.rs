@@ -8,6 +8,9 @@ use deepbrdf_data::merl::{CELLS, INVALID_VALUE, VALUES};
 use deepbrdf_data::MerlTable;
 use rayon::prelude::*;
 
+/// Values per parallel work item; divides [`CELLS`] (1,458,000 = 81 x 18,000).
+const CHUNK: usize = 18_000;
+
 /// Which mapping a baseline uses, before fitting (IPCA's reference comes from the training set).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MappingKind {
@@ -60,11 +63,8 @@ impl Mapping {
                 row[domain.row_index(c, m)] = reference[c * CELLS + cell as usize];
             }
         }
-        let cos_weight = domain
-            .cells()
-            .iter()
-            .map(|&c| ipca::cos_product(c as usize) as f32)
-            .collect::<Vec<_>>();
+        let weights = ipca::cos_weights();
+        let cos_weight = domain.cells().iter().map(|&c| weights[c as usize]).collect::<Vec<_>>();
         debug_assert_eq!(cos_weight.len(), n);
         Self::log_relative_from_parts(domain, row, cos_weight)
     }
@@ -96,24 +96,28 @@ impl Mapping {
         let n = domain.cells().len();
         let values = table.values();
         let mut row = vec![0f32; domain.dim()];
-        row.par_chunks_mut(n).enumerate().for_each(|(c, out)| {
-            for (m, (o, &cell)) in out.iter_mut().zip(domain.cells()).enumerate() {
-                let cell = cell as usize;
-                if !table.is_valid(cell) {
-                    *o = f32::NAN;
-                    continue;
+        for (c, channel) in row.chunks_mut(n).enumerate() {
+            channel.par_chunks_mut(CHUNK).enumerate().for_each(|(b, out)| {
+                let start = b * CHUNK;
+                let cells = &domain.cells()[start..start + out.len()];
+                for ((o, &cell), m) in out.iter_mut().zip(cells).zip(start..) {
+                    let cell = cell as usize;
+                    if !table.is_valid(cell) {
+                        *o = f32::NAN;
+                        continue;
+                    }
+                    let rho = f64::from(values[c * CELLS + cell]);
+                    *o = match self {
+                        Self::Log => pca::log_map(rho),
+                        Self::LogRelative { reference, cos_weight } => ipca::log_relative(
+                            rho,
+                            f64::from(reference[c * n + m]),
+                            f64::from(cos_weight[m]),
+                        ),
+                    } as f32;
                 }
-                let rho = f64::from(values[c * CELLS + cell]);
-                *o = match self {
-                    Self::Log => pca::log_map(rho),
-                    Self::LogRelative { reference, cos_weight } => ipca::log_relative(
-                        rho,
-                        f64::from(reference[c * n + m]),
-                        f64::from(cos_weight[m]),
-                    ),
-                } as f32;
-            }
-        });
+            });
+        }
         row
     }
 
@@ -129,8 +133,12 @@ impl Mapping {
         }
         let n = domain.cells().len();
         let mut values = vec![INVALID_VALUE; VALUES];
-        values.par_chunks_mut(CELLS).enumerate().for_each(|(c, out)| {
-            for (m, &cell) in domain.cells().iter().enumerate() {
+        values.par_chunks_mut(CHUNK).enumerate().for_each(|(b, out)| {
+            // Chunks divide CELLS, so each lies within one channel.
+            let (c, first) = ((b * CHUNK) / CELLS, (b * CHUNK) % CELLS);
+            let positions = domain.positions_in(first..first + out.len());
+            let cells = &domain.cells()[positions.clone()];
+            for (&cell, m) in cells.iter().zip(positions) {
                 let y = f64::from(row[c * n + m]);
                 let rho = match self {
                     Self::Log => pca::log_unmap(y),
@@ -140,7 +148,7 @@ impl Mapping {
                         f64::from(cos_weight[m]),
                     ),
                 };
-                out[cell as usize] = clamp_reflectance(rho);
+                out[cell as usize - first] = clamp_reflectance(rho);
             }
         });
         Ok(MerlTable::from_values(values)?)

@@ -3,7 +3,20 @@
 //! coefficients per BRDF. Both traits are object safe (`&dyn Method`, `Box<dyn Codec>`).
 
 use crate::error::Result;
+use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::{MerlTable, Progress};
+
+/// The training side of one fold as the harness hands it to a [`Method`].
+#[derive(Clone, Copy)]
+pub struct TrainingSet<'a> {
+    pub tables: &'a [&'a MerlTable],
+    /// `names[i]` names `tables[i]`.
+    pub names: &'a [String],
+    /// Eq. (1)'s reference for these tables (their per-value median), computed once per fold
+    /// by the harness (the same one its mapped-space measure uses); methods that need it (IPCA,
+    /// DeepBRDF) take it from here instead of recomputing it.
+    pub reference: &'a MedianReference,
+}
 
 /// A fitted representation with `k` coefficients per BRDF.
 pub trait Codec: Send + Sync {
@@ -41,5 +54,16 @@ pub trait Method: Sync {
         progress: &dyn Progress,
     ) -> Result<Vec<Box<dyn Codec>>> {
         ks.iter().map(|&k| self.fit(train, names, k, progress)).collect()
+    }
+
+    /// What the harness calls: fits one codec per entry of `ks` on one fold's training set.
+    /// The default ignores the precomputed reference and calls [`Method::fit_ks`].
+    fn fit_fold(
+        &self,
+        train: &TrainingSet<'_>,
+        ks: &[usize],
+        progress: &dyn Progress,
+    ) -> Result<Vec<Box<dyn Codec>>> {
+        self.fit_ks(train.tables, train.names, ks, progress)
     }
 }

@@ -3,7 +3,7 @@
 
 use crate::error::{EvalError, Result};
 use crate::ipca;
-use crate::median_reference::MedianReference;
+use deepbrdf_data::mapping::{log_relative, MedianReference};
 use deepbrdf_data::merl::{CELLS, VALUES};
 use deepbrdf_data::MerlTable;
 use rayon::prelude::*;
@@ -58,34 +58,64 @@ impl FromStr for Measure {
     }
 }
 
-/// What the measures compare against: the training median of eq. (1) and the cosine weights.
+/// What the measures compare against: the training median of eq. (1) (and the grid's cosine
+/// weights, [`ipca::cos_weights`]).
 pub struct Yardstick {
     reference: MedianReference,
-    cos_weight: Vec<f32>,
 }
 
-/// One original table prepared for repeated comparisons (its mapping and mask computed once).
+/// One original table prepared for repeated comparisons: its valid cells and their eq. (1)
+/// values, computed once.
 pub struct Original<'a> {
     table: &'a MerlTable,
-    mask: Vec<bool>,
+    /// Cells valid in the original, increasing.
+    cells: Vec<u32>,
+    /// Eq. (1) of the original at `cells`, channel-major (`c * cells.len() + m`).
     mapped: Vec<f32>,
 }
+
+/// Valid cells per parallel work item.
+const CHUNK: usize = 16 * 1024;
 
 impl Yardstick {
     /// The yardstick of a training set: eq. (1)'s reference is their per-value median.
     pub fn from_training(train: &[&MerlTable]) -> Result<Self> {
-        let reference = MedianReference::from_tables(train)?;
-        let cos_weight =
-            (0..CELLS).into_par_iter().map(|c| ipca::cos_product(c).max(0.0) as f32).collect();
-        Ok(Self { reference, cos_weight })
+        Ok(Self::from_reference(MedianReference::from_tables(train)?))
+    }
+
+    /// The yardstick of an already computed eq. (1) reference.
+    pub fn from_reference(reference: MedianReference) -> Self {
+        Self { reference }
+    }
+
+    /// The eq. (1) reference (the per-value median of the training tables).
+    pub fn reference(&self) -> &MedianReference {
+        &self.reference
     }
 
     /// Prepares `table` for comparisons.
     pub fn original<'a>(&self, table: &'a MerlTable) -> Original<'a> {
-        Original { table, mask: table.mask(), mapped: self.reference.map(table) }
+        let cells: Vec<u32> = (0..CELLS as u32)
+            .into_par_iter()
+            .with_min_len(CHUNK)
+            .filter(|&c| table.is_valid(c as usize))
+            .collect();
+        let n = cells.len();
+        let (v, r) = (table.values(), self.reference.values());
+        let mut mapped = vec![0f32; 3 * n];
+        for (c, out) in mapped.chunks_mut(n.max(1)).enumerate() {
+            out.par_chunks_mut(CHUNK).zip(cells.par_chunks(CHUNK)).for_each(|(out, cells)| {
+                for (o, &cell) in out.iter_mut().zip(cells) {
+                    let i = c * CELLS + cell as usize;
+                    *o = log_relative(f64::from(v[i]), f64::from(r[i])) as f32;
+                }
+            });
+        }
+        Original { table, cells, mapped }
     }
 
-    /// All `measures` of `recon` against `original`, in the given order.
+    /// All `measures` of `recon` against `original`, in the given order. A reconstruction that
+    /// is invalid (negative) where the original is valid counts as reflectance 0 there.
     pub fn measure(
         &self,
         original: &Original,
@@ -95,63 +125,93 @@ impl Yardstick {
         if recon.values().len() != VALUES {
             return Err(EvalError::Invalid("reconstruction is not a full table".into()));
         }
-        // A reconstruction invalid where the original is valid counts as reflectance 0 there.
-        let patched;
-        let recon = if (0..CELLS).any(|c| original.mask[c] && !recon.is_valid(c)) {
-            let mut values = recon.values().to_vec();
-            for c in 0..CELLS {
-                if original.mask[c] && !recon.is_valid(c) {
-                    for ch in 0..3 {
-                        values[ch * CELLS + c] = values[ch * CELLS + c].max(0.0);
-                    }
-                }
-            }
-            patched = MerlTable::from_values(values)?;
-            &patched
-        } else {
-            recon
-        };
-        let valid = original.mask.iter().filter(|&&m| m).count();
-        if valid == 0 {
+        let n = original.cells.len();
+        if n == 0 {
             return Err(EvalError::Invalid("the original table has no valid cell".into()));
         }
-        let count = (3 * valid) as f64;
-        let mut out = Vec::with_capacity(measures.len());
-        for m in measures {
-            let value = match m {
-                Measure::MappedMse => {
-                    let mapped = self.reference.map(recon);
-                    sum_over_valid(&original.mask, |i| {
-                        let d = f64::from(original.mapped[i]) - f64::from(mapped[i]);
-                        d * d
-                    }) / count
+        let want_mapped = measures.contains(&Measure::MappedMse);
+        let (a, b, r) = (original.table.values(), recon.values(), self.reference.values());
+        let weights = ipca::cos_weights();
+        // Sums of squared eq. (1) differences and of squared cosine-weighted differences.
+        let (mapped_sum, cos_sum) = original
+            .cells
+            .par_chunks(CHUNK)
+            .enumerate()
+            .map(|(chunk, cells)| {
+                let (mut mapped_sum, mut cos_sum) = (0f64, 0f64);
+                for (m, &cell) in (chunk * CHUNK..).zip(cells) {
+                    let cell = cell as usize;
+                    let w = f64::from(weights[cell].max(0.0));
+                    for c in 0..3 {
+                        let i = c * CELLS + cell;
+                        let rho_hat = f64::from(b[i].max(0.0));
+                        let d = (f64::from(a[i]) - rho_hat) * w;
+                        cos_sum += d * d;
+                        if want_mapped {
+                            let d = f64::from(original.mapped[c * n + m])
+                                - f64::from(log_relative(rho_hat, f64::from(r[i])) as f32);
+                            mapped_sum += d * d;
+                        }
+                    }
                 }
-                Measure::CosRmse => {
-                    let (a, b) = (original.table.values(), recon.values());
-                    (sum_over_valid(&original.mask, |i| {
-                        let w = f64::from(self.cos_weight[i % CELLS]);
-                        let d = (f64::from(a[i]) - f64::from(b[i])) * w;
-                        d * d
-                    }) / count)
-                        .sqrt()
-                }
-            };
-            out.push(value);
-        }
-        Ok(out)
+                (mapped_sum, cos_sum)
+            })
+            .reduce(|| (0.0, 0.0), |x, y| (x.0 + y.0, x.1 + y.1));
+        let count = (3 * n) as f64;
+        Ok(measures
+            .iter()
+            .map(|m| match m {
+                Measure::MappedMse => mapped_sum / count,
+                Measure::CosRmse => (cos_sum / count).sqrt(),
+            })
+            .collect())
     }
 }
 
-/// Sum of `f(i)` over every value index `i` (all three channels) whose cell is valid in `mask`.
-fn sum_over_valid(mask: &[bool], f: impl Fn(usize) -> f64 + Sync) -> f64 {
-    (0..3)
-        .into_par_iter()
-        .map(|ch| {
-            mask.par_iter()
-                .enumerate()
-                .filter(|(_, &m)| m)
-                .map(|(c, _)| f(ch * CELLS + c))
-                .sum::<f64>()
-        })
-        .sum()
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::synthetic_table;
+
+    #[test]
+    fn measures_match_their_definitions_written_out() {
+        let (a, b) = (synthetic_table(0), synthetic_table(3));
+        let yardstick = Yardstick::from_training(&[&a, &b, &synthetic_table(5)]).unwrap();
+        let original = yardstick.original(&a);
+        // The reconstruction loses a few cells (invalid where the original is valid): they count
+        // as reflectance 0.
+        let mut recon = b.clone();
+        let lost = [deepbrdf_data::merl::cell_index(3, 4, 5), 777_777];
+        for &cell in &lost {
+            assert!(a.is_valid(cell));
+            recon.values_mut()[CELLS + cell] = -1.0;
+        }
+        let got = yardstick.measure(&original, &recon, &Measure::ALL).unwrap();
+        // Independent computation: the reference's own full-table map (eq. 1), all cells.
+        let (ma, mut zeroed) = (yardstick.reference().map(&a), recon.values().to_vec());
+        for &cell in &lost {
+            for c in 0..3 {
+                zeroed[c * CELLS + cell] = zeroed[c * CELLS + cell].max(0.0);
+            }
+        }
+        let mb = yardstick.reference().map(&MerlTable::from_values(zeroed.clone()).unwrap());
+        let (mut mse, mut cos, mut count) = (0f64, 0f64, 0usize);
+        for cell in (0..CELLS).filter(|&c| a.is_valid(c)) {
+            let w = ipca::cos_product(cell);
+            for c in 0..3 {
+                let i = c * CELLS + cell;
+                mse += (f64::from(ma[i]) - f64::from(mb[i])).powi(2);
+                cos += ((f64::from(a.values()[i]) - f64::from(zeroed[i])) * w).powi(2);
+                count += 1;
+            }
+        }
+        let (mse, rmse) = (mse / count as f64, (cos / count as f64).sqrt());
+        assert!((got[0] - mse).abs() <= 1e-9 * mse, "mapped mse {} vs {mse}", got[0]);
+        assert!((got[1] - rmse).abs() <= 1e-6 * rmse, "cos rmse {} vs {rmse}", got[1]);
+        // A perfect reconstruction scores 0 on every measure.
+        assert_eq!(yardstick.measure(&original, &a, &Measure::ALL).unwrap(), vec![0.0, 0.0]);
+        // Order follows the request.
+        let one = yardstick.measure(&original, &recon, &[Measure::CosRmse]).unwrap();
+        assert_eq!(one, vec![got[1]]);
+    }
 }

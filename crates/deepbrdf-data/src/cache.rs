@@ -1,0 +1,284 @@
+//! On-disk cache of tabulated NBRDF tables, so each bundled material is tabulated once.
+//!
+//! One file per material, `<dir>/tables/<name>-<key>.tab`, where `<key>` starts the hex
+//! SHA-256 of the network's parameters and [`TABULATOR_VERSION`]: a changed network or a changed
+//! tabulator gives a new key, so stale tables are never read (and are pruned when replaced).
+//! Files are written to a temporary name and renamed into place. Reading checks the size, the
+//! header (magic, versions, key) and a SHA-256 of the values before trusting anything; a
+//! corrupt or truncated file is recomputed and replaced.
+//!
+//! File layout (little-endian): magic `DBRDFTAB` (8 bytes), format version u32, tabulator version
+//! u32, key (32 bytes), SHA-256 of the values (32 bytes), then [`VALUES`] f32.
+
+use crate::error::{DataError, Result};
+use crate::merl::{MerlTable, VALUES};
+use crate::nbrdf::{tabulate, Network, TABULATOR_VERSION};
+use sha2::{Digest, Sha256};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Environment variable that overrides the default cache directory.
+pub const CACHE_ENV: &str = "DEEPBRDF_CACHE";
+/// Magic bytes opening a cached table.
+const MAGIC: [u8; 8] = *b"DBRDFTAB";
+/// Version of the cache file layout.
+const FORMAT_VERSION: u32 = 1;
+/// Bytes before the values.
+const HEADER: usize = 8 + 4 + 4 + 32 + 32;
+/// Exact size of a cached table file.
+const FILE_BYTES: u64 = (HEADER + VALUES * 4) as u64;
+/// Hex digits of the key used in file names.
+const KEY_DIGITS: usize = 16;
+
+/// Where a table came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outcome {
+    /// Read from a valid cache file.
+    Hit,
+    /// Tabulated: there was no cache file (or caching is disabled).
+    Computed,
+    /// Tabulated because the cache file was corrupt, truncated or foreign.
+    Recomputed,
+}
+
+/// The table cache: a directory, or disabled (always tabulate, write nothing).
+#[derive(Debug, Clone)]
+pub struct Cache {
+    dir: Option<PathBuf>,
+}
+
+impl Cache {
+    /// A cache in `dir` (created on first write).
+    pub fn at(dir: impl Into<PathBuf>) -> Self {
+        Self { dir: Some(dir.into()) }
+    }
+
+    /// No caching: tables are tabulated on every request.
+    pub fn disabled() -> Self {
+        Self { dir: None }
+    }
+
+    /// The default cache: `$DEEPBRDF_CACHE` if set and non-empty, else the platform's cache
+    /// directory + `deepbrdf` (e.g. `~/.cache/deepbrdf`); disabled if neither exists.
+    pub fn default_location() -> Self {
+        match std::env::var_os(CACHE_ENV).filter(|v| !v.is_empty()) {
+            Some(dir) => Self::at(dir),
+            None => Self { dir: dirs::cache_dir().map(|d| d.join("deepbrdf")) },
+        }
+    }
+
+    /// The cache directory, if caching is enabled.
+    pub fn dir(&self) -> Option<&Path> {
+        self.dir.as_deref()
+    }
+
+    /// The cache key of `net`: SHA-256 over the tabulator version and the network's parameters.
+    pub fn key(net: &Network) -> [u8; 32] {
+        let mut h = Sha256::new();
+        h.update(b"deepbrdf nbrdf table");
+        h.update(TABULATOR_VERSION.to_le_bytes());
+        h.update(net.parameter_bytes());
+        h.finalize().into()
+    }
+
+    /// The cache file of `net`, if caching is enabled.
+    pub fn path_for(&self, net: &Network) -> Option<PathBuf> {
+        let key = hex::encode(Self::key(net));
+        let name = format!("{}-{}.tab", file_safe(net.name()), &key[..KEY_DIGITS]);
+        self.dir.as_ref().map(|d| d.join("tables").join(name))
+    }
+
+    /// The tabulated table of `net`, from the cache when a valid file exists, else tabulated and
+    /// stored.
+    pub fn tabulated(&self, net: &Network) -> Result<MerlTable> {
+        self.tabulated_with_outcome(net).map(|(table, _)| table)
+    }
+
+    /// Like [`Cache::tabulated`], also saying whether the cache was used.
+    pub fn tabulated_with_outcome(&self, net: &Network) -> Result<(MerlTable, Outcome)> {
+        let Some(path) = self.path_for(net) else {
+            return Ok((tabulate(net)?, Outcome::Computed));
+        };
+        let key = Self::key(net);
+        let outcome = match read_cached(&path, &key) {
+            Ok(Some(table)) => return Ok((table, Outcome::Hit)),
+            Ok(None) => Outcome::Computed,
+            Err(_) => Outcome::Recomputed,
+        };
+        let table = tabulate(net)?;
+        store(&path, &key, &table)?;
+        prune_stale(&path, net.name());
+        Ok((table, outcome))
+    }
+}
+
+/// A material name made safe as a file-name part.
+fn file_safe(name: &str) -> String {
+    name.chars()
+        .map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' })
+        .collect()
+}
+
+/// Reads a cached table: `Ok(None)` if there is no file, `Err` if it is not a valid table
+/// for `key`.
+fn read_cached(path: &Path, key: &[u8; 32]) -> Result<Option<MerlTable>> {
+    use std::io::Read;
+    let mut file = match std::fs::File::open(path) {
+        Ok(f) => f,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(DataError::io(path, e)),
+    };
+    let len = file.metadata().map_err(|e| DataError::io(path, e))?.len();
+    if len != FILE_BYTES {
+        return Err(DataError::format(
+            path,
+            format!("{len} bytes, a cached table has {FILE_BYTES}"),
+        ));
+    }
+    let mut header = [0u8; HEADER];
+    file.read_exact(&mut header).map_err(|e| DataError::io(path, e))?;
+    let u32_at = |at: usize| {
+        u32::from_le_bytes([header[at], header[at + 1], header[at + 2], header[at + 3]])
+    };
+    if header[..8] != MAGIC || u32_at(8) != FORMAT_VERSION || u32_at(12) != TABULATOR_VERSION {
+        return Err(DataError::format(path, "not a cached table of this version"));
+    }
+    if header[16..48] != key[..] {
+        return Err(DataError::format(path, "cached table of another network"));
+    }
+    let mut payload = vec![0u8; VALUES * 4];
+    file.read_exact(&mut payload).map_err(|e| DataError::io(path, e))?;
+    if Sha256::digest(&payload).as_slice() != &header[48..80] {
+        return Err(DataError::format(path, "checksum mismatch"));
+    }
+    let values: Vec<f32> =
+        payload.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
+    drop(payload);
+    MerlTable::from_values(values).map(Some).map_err(|e| DataError::format(path, e.to_string()))
+}
+
+/// Writes a cached table atomically.
+fn store(path: &Path, key: &[u8; 32], table: &MerlTable) -> Result<()> {
+    let mut bytes = Vec::with_capacity(FILE_BYTES as usize);
+    bytes.extend(MAGIC);
+    bytes.extend(FORMAT_VERSION.to_le_bytes());
+    bytes.extend(TABULATOR_VERSION.to_le_bytes());
+    bytes.extend(key);
+    bytes.extend([0u8; 32]);
+    bytes.extend(table.values().iter().flat_map(|v| v.to_le_bytes()));
+    let digest = Sha256::digest(&bytes[HEADER..]);
+    bytes[48..80].copy_from_slice(&digest);
+    write_atomically(path, &bytes)
+}
+
+/// Removes other cache files of the same material (older keys).
+fn prune_stale(current: &Path, name: &str) {
+    let (Some(dir), Some(cur)) = (current.parent(), current.file_name()) else { return };
+    let prefix = format!("{}-", file_safe(name));
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for entry in entries.flatten() {
+        let file = entry.file_name();
+        let Some(f) = file.to_str() else { continue };
+        let is_same_material = f
+            .strip_prefix(&prefix)
+            .and_then(|rest| rest.strip_suffix(".tab"))
+            .is_some_and(|k| k.len() == KEY_DIGITS && k.bytes().all(|b| b.is_ascii_hexdigit()));
+        if is_same_material && file != cur {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+}
+
+/// Writes `bytes` to `path` without ever leaving a partial file under that name: write a
+/// uniquely named temporary file in the same directory, then rename it over `path`.
+/// Creates the parent directory if needed.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    std::fs::create_dir_all(&dir).map_err(|e| DataError::io(&dir, e))?;
+    let file_name = path.file_name().and_then(|n| n.to_str()).unwrap_or("file");
+    let tmp = dir.join(format!(
+        ".{file_name}.{}-{}.tmp",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    let result = std::fs::write(&tmp, bytes)
+        .map_err(|e| DataError::io(&tmp, e))
+        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| DataError::io(path, e)));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::nbrdf::PARAMETERS;
+
+    fn small_net(name: &str, scale: f32) -> Network {
+        let mut params: Vec<f32> =
+            (0..PARAMETERS).map(|i| ((i as f32) * 0.37).sin() * scale).collect();
+        // Output biases well above 0, so the table is not clamped to all zeros.
+        params[PARAMETERS - 3..].fill(1.0 + scale);
+        Network::from_parameters(name, &params).expect("valid")
+    }
+
+    #[test]
+    fn cache_hits_invalidates_and_recovers_from_corruption() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let cache = Cache::at(dir.path());
+        let net = small_net("mat", 0.3);
+        let (first, outcome) = cache.tabulated_with_outcome(&net).expect("tabulate");
+        assert_eq!(outcome, Outcome::Computed);
+        let path = cache.path_for(&net).expect("enabled");
+        assert_eq!(std::fs::metadata(&path).expect("written").len(), FILE_BYTES);
+        let (again, outcome) = cache.tabulated_with_outcome(&net).expect("hit");
+        assert_eq!(outcome, Outcome::Hit);
+        assert_eq!(again, first);
+
+        // Truncated file: detected, recomputed, replaced.
+        let full = std::fs::read(&path).expect("read");
+        std::fs::write(&path, &full[..full.len() / 2]).expect("truncate");
+        let (t, outcome) = cache.tabulated_with_outcome(&net).expect("recompute");
+        assert_eq!((outcome, &t), (Outcome::Recomputed, &first));
+        assert_eq!(cache.tabulated_with_outcome(&net).expect("hit").1, Outcome::Hit);
+
+        // One flipped bit in the values: caught by the checksum.
+        let mut flipped = full.clone();
+        flipped[HEADER + 12345] ^= 0x10;
+        std::fs::write(&path, &flipped).expect("corrupt");
+        let (t, outcome) = cache.tabulated_with_outcome(&net).expect("recompute");
+        assert_eq!((outcome, &t), (Outcome::Recomputed, &first));
+
+        // A changed network gets a new key and file; the stale one is pruned.
+        let changed = small_net("mat", 0.31);
+        let new_path = cache.path_for(&changed).expect("enabled");
+        assert_ne!(new_path, path);
+        let (t, outcome) = cache.tabulated_with_outcome(&changed).expect("tabulate");
+        assert_eq!(outcome, Outcome::Computed);
+        assert_ne!(t, first);
+        assert!(!path.exists() && new_path.exists());
+
+        // A file holding another network's table under this key's name is not trusted.
+        std::fs::copy(&new_path, &path).expect("copy");
+        assert!(read_cached(&path, &Cache::key(&net)).is_err());
+        let leftovers: Vec<_> = std::fs::read_dir(path.parent().expect("dir"))
+            .expect("list")
+            .flatten()
+            .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
+            .collect();
+        assert!(leftovers.is_empty());
+    }
+
+    #[test]
+    fn disabled_cache_writes_nothing() {
+        let cache = Cache::disabled();
+        let net = small_net("m", 0.2);
+        assert!(cache.path_for(&net).is_none());
+        assert_eq!(cache.tabulated_with_outcome(&net).expect("tabulate").1, Outcome::Computed);
+    }
+}

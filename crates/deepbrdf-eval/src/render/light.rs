@@ -1,0 +1,235 @@
+//! Lights: directional lights (irradiance from one direction, sampled exactly) and environment
+//! lights (radiance from every direction: a constant one for the white-furnace test, or the
+//! procedural sun and sky of [`super::sky`]).
+
+use super::brdf::Rgb;
+use super::geometry::Vec3;
+use super::sky::{SunSky, SunSkyConfig};
+use crate::error::{EvalError, Result};
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+use std::fmt;
+use std::str::FromStr;
+
+/// Light arriving from a single direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DirectionalLight {
+    /// Unit direction towards the light (world, z up).
+    pub direction: Vec3,
+    /// Irradiance on a surface facing the light, per channel.
+    pub irradiance: Rgb,
+}
+
+/// Radiance arriving from all directions.
+#[derive(Clone, Debug)]
+pub enum Environment {
+    /// The same radiance from every direction (the white furnace).
+    Constant(Rgb),
+    /// Preetham sun and sky (boxed: it carries its tabulated map).
+    SunSky(Box<SunSky>),
+}
+
+impl Environment {
+    /// Radiance arriving from unit direction `dir`.
+    #[inline]
+    pub fn radiance(&self, dir: Vec3) -> Rgb {
+        match self {
+            Self::Constant(l) => *l,
+            Self::SunSky(s) => s.radiance(dir),
+        }
+    }
+
+    /// Draws a direction from `u` uniform in [0,1)^2: `(direction, radiance, solid-angle pdf)`.
+    /// The constant environment is sampled uniformly over the sphere.
+    #[inline]
+    pub fn sample(&self, u: [f64; 2]) -> (Vec3, Rgb, f64) {
+        match self {
+            Self::Constant(l) => {
+                let z = 1.0 - 2.0 * u[0];
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                let (s, c) = (2.0 * PI * u[1]).sin_cos();
+                (Vec3::new(r * c, r * s, z), *l, 1.0 / (4.0 * PI))
+            }
+            Self::SunSky(s) => s.sample(u),
+        }
+    }
+
+    /// Radiance from `dir` and the density of [`Environment::sample`] there, together.
+    #[inline]
+    pub fn eval(&self, dir: Vec3) -> (Rgb, f64) {
+        match self {
+            Self::Constant(l) => (*l, 1.0 / (4.0 * PI)),
+            Self::SunSky(s) => s.eval(dir),
+        }
+    }
+
+    /// Solid-angle density of [`Environment::sample`] at `dir`.
+    #[inline]
+    pub fn pdf(&self, dir: Vec3) -> f64 {
+        match self {
+            Self::Constant(_) => 1.0 / (4.0 * PI),
+            Self::SunSky(s) => s.pdf(dir),
+        }
+    }
+}
+
+/// All the light of a scene.
+#[derive(Clone, Debug, Default)]
+pub struct Lighting {
+    pub directional: Vec<DirectionalLight>,
+    pub environment: Option<Environment>,
+}
+
+/// The lighting choices of the command line, parsed from `sun:ELEV,AZIM[,TURBIDITY]`,
+/// `dir:THETA,PHI` or `const[:L]` (angles in degrees).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum LightSpec {
+    /// Preetham sun and sky; exposure normalised (see [`super::sky`]).
+    Sun { elevation_deg: f64, azimuth_deg: f64, turbidity: f64 },
+    /// One directional light at polar angle `theta_deg` from the zenith and azimuth `phi_deg`,
+    /// irradiance pi (a white Lambertian facing it has radiance 1).
+    Directional { theta_deg: f64, phi_deg: f64 },
+    /// Constant environment of radiance `radiance`.
+    Constant { radiance: f64 },
+}
+
+impl Default for LightSpec {
+    fn default() -> Self {
+        let c = SunSkyConfig::default();
+        Self::Sun {
+            elevation_deg: c.elevation_deg,
+            azimuth_deg: c.azimuth_deg,
+            turbidity: c.turbidity,
+        }
+    }
+}
+
+impl LightSpec {
+    /// Builds the lighting (tabulating the sky once).
+    pub fn build(&self) -> Result<Lighting> {
+        Ok(match *self {
+            Self::Sun { elevation_deg, azimuth_deg, turbidity } => Lighting {
+                directional: Vec::new(),
+                environment: Some(Environment::SunSky(Box::new(SunSky::new(SunSkyConfig {
+                    elevation_deg,
+                    azimuth_deg,
+                    turbidity,
+                    ..Default::default()
+                })?))),
+            },
+            Self::Directional { theta_deg, phi_deg } => {
+                if !(theta_deg.is_finite() && phi_deg.is_finite()) {
+                    return Err(EvalError::Invalid(format!(
+                        "light direction {self} is not finite"
+                    )));
+                }
+                Lighting {
+                    directional: vec![DirectionalLight {
+                        direction: Vec3::from_spherical(
+                            theta_deg.to_radians(),
+                            phi_deg.to_radians(),
+                        ),
+                        irradiance: [PI; 3],
+                    }],
+                    environment: None,
+                }
+            }
+            Self::Constant { radiance } => {
+                if !(radiance.is_finite() && radiance >= 0.0) {
+                    return Err(EvalError::Invalid(format!(
+                        "constant radiance {radiance} must be finite and >= 0"
+                    )));
+                }
+                Lighting {
+                    directional: Vec::new(),
+                    environment: Some(Environment::Constant([radiance; 3])),
+                }
+            }
+        })
+    }
+}
+
+impl fmt::Display for LightSpec {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Sun { elevation_deg, azimuth_deg, turbidity } => {
+                write!(f, "sun:{elevation_deg},{azimuth_deg},{turbidity}")
+            }
+            Self::Directional { theta_deg, phi_deg } => write!(f, "dir:{theta_deg},{phi_deg}"),
+            Self::Constant { radiance } => write!(f, "const:{radiance}"),
+        }
+    }
+}
+
+fn parse_numbers(spec: &str, list: &str, min: usize, max: usize) -> Result<Vec<f64>> {
+    let values: std::result::Result<Vec<f64>, _> =
+        list.split(',').map(|s| s.trim().parse::<f64>()).collect();
+    match values {
+        Ok(v) if (min..=max).contains(&v.len()) && v.iter().all(|x| x.is_finite()) => Ok(v),
+        _ => Err(EvalError::Invalid(format!(
+            "light '{spec}': expected {min}{} finite numbers separated by commas",
+            if max > min { format!(" to {max}") } else { String::new() }
+        ))),
+    }
+}
+
+impl FromStr for LightSpec {
+    type Err = EvalError;
+    fn from_str(spec: &str) -> Result<Self> {
+        let (kind, rest) = spec.split_once(':').unwrap_or((spec, ""));
+        match kind {
+            "sun" => {
+                let v = parse_numbers(spec, rest, 2, 3)?;
+                Ok(Self::Sun {
+                    elevation_deg: v[0],
+                    azimuth_deg: v[1],
+                    turbidity: v.get(2).copied().unwrap_or(SunSkyConfig::default().turbidity),
+                })
+            }
+            "dir" => {
+                let v = parse_numbers(spec, rest, 2, 2)?;
+                Ok(Self::Directional { theta_deg: v[0], phi_deg: v[1] })
+            }
+            "const" if rest.is_empty() => Ok(Self::Constant { radiance: 1.0 }),
+            "const" => Ok(Self::Constant { radiance: parse_numbers(spec, rest, 1, 1)?[0] }),
+            _ => Err(EvalError::Invalid(format!(
+                "light '{spec}': expected sun:ELEV,AZIM[,TURBIDITY], dir:THETA,PHI or const[:L]"
+            ))),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_and_prints_specs() {
+        assert_eq!(
+            "sun:30,45".parse::<LightSpec>().unwrap(),
+            LightSpec::Sun { elevation_deg: 30.0, azimuth_deg: 45.0, turbidity: 3.0 }
+        );
+        assert_eq!(
+            "dir:10,-20".parse::<LightSpec>().unwrap(),
+            LightSpec::Directional { theta_deg: 10.0, phi_deg: -20.0 }
+        );
+        assert_eq!("const".parse::<LightSpec>().unwrap(), LightSpec::Constant { radiance: 1.0 });
+        for s in ["sun:30,45,4", "dir:1,2", "const:2.5"] {
+            let spec: LightSpec = s.parse().unwrap();
+            assert_eq!(spec.to_string().parse::<LightSpec>().unwrap(), spec);
+        }
+        for bad in ["sun", "sun:1", "sun:a,b", "dir:1,2,3", "const:x", "lamp:1", "sun:nan,3"] {
+            assert!(bad.parse::<LightSpec>().is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn constant_environment_samples_the_sphere_uniformly() {
+        let env = Environment::Constant([2.0; 3]);
+        let (d, l, p) = env.sample([0.3, 0.7]);
+        assert!((d.length() - 1.0).abs() < 1e-12);
+        assert_eq!(l, [2.0; 3]);
+        assert_eq!(p, env.pdf(d));
+    }
+}
