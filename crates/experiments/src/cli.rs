@@ -17,4 +17,6 @@ pub struct Cli {
 pub enum Command {
     /// List the compute devices compiled into this binary.
     Devices(commands::devices::Args),
+    /// Download the official MERL BRDF database (100 `.binary` files), verified by SHA-256.
+    FetchMerl(commands::fetch_merl::Args),
 }
