@@ -2,3 +2,4 @@
 mod util;
 
 mod devices;
+mod fetch_merl;

@@ -19,4 +19,6 @@ pub enum Command {
     Devices(commands::devices::Args),
     /// Benchmarks that print speed numbers.
     Bench(commands::bench::Args),
+    /// Download the official MERL BRDF database (100 `.binary` files), verified by SHA-256.
+    FetchMerl(commands::fetch_merl::Args),
 }
