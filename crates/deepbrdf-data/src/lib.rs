@@ -2,6 +2,7 @@
 pub mod augment;
 pub mod bundled;
 pub mod cache;
+pub mod dataset;
 pub mod error;
 pub mod fetch;
 mod files;
@@ -11,6 +12,7 @@ pub mod merl;
 pub mod nbrdf;
 pub mod progress;
 pub mod testing;
+pub mod summary;
 
 pub use error::{DataError, Result};
 pub use merl::MerlTable;

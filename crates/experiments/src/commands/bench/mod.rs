@@ -4,6 +4,7 @@ use deepbrdf_data::Progress;
 
 pub mod io;
 pub mod lookup;
+pub mod tabulate;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -18,11 +19,14 @@ pub enum What {
     Io(io::Args),
     /// MERL table lookup speed, nearest and interpolated, one thread.
     Lookup(lookup::Args),
+    /// Tabulating bundled NBRDF networks onto the MERL grid (target: 100 materials < 30 s).
+    Tabulate(tabulate::Args),
 }
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     match args.what {
         What::Io(a) => io::run(a, progress),
         What::Lookup(a) => lookup::run(a, progress),
+        What::Tabulate(a) => tabulate::run(a, progress),
     }
 }
