@@ -9,13 +9,13 @@
 mod ggx;
 mod lambertian;
 mod lobe;
-// mod merl;
+mod merl;
 mod sum;
 
 pub use ggx::Ggx;
 pub use lambertian::Lambertian;
 pub use lobe::SamplingLobe;
-// pub use merl::{MerlBrdf, MerlLookup};
+pub use merl::{MerlBrdf, MerlLookup};
 pub use sum::Sum;
 
 use super::geometry::Vec3;
