@@ -7,12 +7,14 @@
 //! light and `wo` towards the viewer, the argument order of `MerlTable::lookup_interpolated`.
 
 mod ggx;
+mod interleaved;
 mod lambertian;
 mod lobe;
 mod merl;
 mod sum;
 
 pub use ggx::Ggx;
+pub use interleaved::InterleavedTable;
 pub use lambertian::Lambertian;
 pub use lobe::SamplingLobe;
 pub use merl::{MerlBrdf, MerlLookup};
