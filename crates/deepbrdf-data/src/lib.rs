@@ -1,7 +1,8 @@
 //! `deepbrdf-data`: measured BRDF data for DeepBRDF (Hu et al., CGF 2020, §3.1).
+pub mod augment;
 pub mod bundled;
 pub mod cache;
-pub mod augment;
+pub mod dataset;
 pub mod error;
 mod files;
 pub mod layout;
@@ -9,6 +10,7 @@ pub mod mapping;
 pub mod merl;
 pub mod nbrdf;
 pub mod progress;
+pub mod summary;
 
 pub use error::{DataError, Result};
 pub use merl::MerlTable;
