@@ -11,8 +11,8 @@ pub mod mapping;
 pub mod merl;
 pub mod nbrdf;
 pub mod progress;
-pub mod testing;
 pub mod summary;
+pub mod testing;
 
 pub use error::{DataError, Result};
 pub use merl::MerlTable;
