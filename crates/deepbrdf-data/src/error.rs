@@ -21,6 +21,9 @@ pub enum DataError {
     /// An argument or in-memory value that is out of range or inconsistent.
     #[error("{0}")]
     Invalid(String),
+    /// A download of the MERL database failed (see [`crate::fetch`]).
+    #[error(transparent)]
+    Fetch(#[from] crate::fetch::FetchError),
 }
 
 impl DataError {

@@ -4,6 +4,7 @@ pub mod bundled;
 pub mod cache;
 pub mod dataset;
 pub mod error;
+pub mod fetch;
 mod files;
 pub mod layout;
 pub mod mapping;
@@ -11,6 +12,7 @@ pub mod merl;
 pub mod nbrdf;
 pub mod progress;
 pub mod summary;
+pub mod testing;
 
 pub use error::{DataError, Result};
 pub use merl::MerlTable;

@@ -5,7 +5,6 @@ pub mod error;
 pub mod figures;
 pub mod harness;
 pub mod ipca;
-mod median_reference;
 pub mod pca;
 pub mod render;
 #[cfg(test)]

@@ -26,4 +26,6 @@ pub enum Command {
     Tabulate(commands::tabulate::Args),
     /// Pack folders of JSON NBRDF networks into the bundled .nbrdf files.
     PackNbrdf(commands::pack_nbrdf::Args),
+    /// Download the official MERL BRDF database (100 `.binary` files), verified by SHA-256.
+    FetchMerl(commands::fetch_merl::Args),
 }

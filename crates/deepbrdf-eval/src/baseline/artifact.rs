@@ -15,8 +15,10 @@
 //! ref      f32 x dim    (IPCA only; the cosine weights are recomputed from the grid)
 //! sha256   32 bytes
 //! ```
-//! The expected length follows from the header and is checked against the file's size before
-//! anything large is allocated.
+//! Loading checks, in this order, before anything large is allocated: the magic, the mapping
+//! kind, the name length, the sizes (domain cells <= the grid's, 1 <= k < n_train, k <= 4096),
+//! and that the file's length is exactly what the header implies; then the whole file is read
+//! and its SHA-256 compared before any value is interpreted.
 
 use super::{BaselineBasis, Domain, Mapping};
 use crate::error::{EvalError, Result};
@@ -111,7 +113,11 @@ impl<'a> Reader<'a> {
 
 pub(super) fn load(path: &Path) -> Result<BaselineBasis> {
     let mut file = std::fs::File::open(path).map_err(|e| EvalError::io(path, e))?;
-    let size = file.metadata().map_err(|e| EvalError::io(path, e))?.len();
+    let meta = file.metadata().map_err(|e| EvalError::io(path, e))?;
+    if !meta.is_file() {
+        return Err(EvalError::format(path, "not a regular file (a basis file was expected)"));
+    }
+    let size = meta.len();
     // Read the fixed header first; the payload size follows from it.
     let mut head = vec![0u8; 16];
     file.read_exact(&mut head)
@@ -130,6 +136,7 @@ pub(super) fn load(path: &Path) -> Result<BaselineBasis> {
     let mut rest = vec![0u8; name_len + 24];
     file.read_exact(&mut rest).map_err(|_| EvalError::format(path, "truncated basis header"))?;
     let le = |s: &[u8]| u64::from_le_bytes(s.try_into().unwrap_or_default());
+    let n_train = le(&rest[name_len..name_len + 8]);
     let n_cells = le(&rest[name_len + 8..name_len + 16]);
     let k = le(&rest[name_len + 16..name_len + 24]);
     if n_cells == 0 || n_cells > CELLS as u64 {
@@ -137,6 +144,13 @@ pub(super) fn load(path: &Path) -> Result<BaselineBasis> {
     }
     if k == 0 || k > MAX_K as u64 {
         return Err(EvalError::format(path, format!("absurd component count {k}")));
+    }
+    // n centred rows have rank n - 1 at most, so a fitted basis has k < n_train.
+    if n_train < 2 || k >= n_train {
+        return Err(EvalError::format(
+            path,
+            format!("inconsistent header: {k} components from {n_train} training materials"),
+        ));
     }
     let (n_cells, k) = (n_cells as usize, k as usize);
     let dim = 3 * n_cells;
@@ -163,8 +177,8 @@ pub(super) fn load(path: &Path) -> Result<BaselineBasis> {
     let mut r = Reader { bytes: body, at: 16, path };
     let name = String::from_utf8(r.take(name_len)?.to_vec())
         .map_err(|_| EvalError::format(path, "basis name is not UTF-8"))?;
-    let n_train = r.u64()? as usize;
-    let _ = (r.u64()?, r.u64()?);
+    let _ = (r.u64()?, r.u64()?, r.u64()?);
+    let n_train = n_train as usize;
     let cells: Vec<u32> = (0..n_cells).map(|_| r.u32()).collect::<Result<_>>()?;
     let mean = r.f32s(dim)?;
     let sigmas: Vec<f64> = r

@@ -10,11 +10,11 @@ pub use mapping::{Mapping, MappingKind};
 
 use crate::error::{EvalError, Result};
 use crate::harness::{Codec, Method, TrainingSet};
-use crate::median_reference::MedianReference;
 use crate::pca::LinearBasis;
+use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::{MerlTable, Progress};
 use std::path::Path;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 /// A fitted baseline: domain, mapping and linear basis. Codecs of any `k <= basis.k()` share it.
 #[derive(Clone, Debug, PartialEq)]
@@ -184,12 +184,29 @@ impl Codec for BaselineCodec {
 pub struct BaselineMethod {
     name: String,
     kind: MappingKind,
+    /// Whether to keep the latest fitted basis in `last` (see [`BaselineMethod::last_fit`]).
+    keep_last: bool,
+    last: Arc<Mutex<Option<Arc<BaselineBasis>>>>,
 }
 
 impl BaselineMethod {
     /// A baseline named `name` with mapping `kind`.
     pub fn new(name: &str, kind: MappingKind) -> Self {
-        Self { name: name.to_string(), kind }
+        Self { name: name.to_string(), kind, keep_last: false, last: Arc::default() }
+    }
+
+    /// The same method, keeping the basis of its latest harness fit (to save it as an
+    /// artifact afterwards). Off by default: a basis of 40 components over the full grid is
+    /// about 0.5 GB.
+    pub fn keeping_last_fit(mut self) -> Self {
+        self.keep_last = true;
+        self
+    }
+
+    /// The basis of the latest fit through [`Method::fit_ks`] or [`Method::fit_fold`], when
+    /// [`BaselineMethod::keeping_last_fit`] was asked for.
+    pub fn last_fit(&self) -> Option<Arc<BaselineBasis>> {
+        self.last.lock().ok().and_then(|slot| slot.clone())
     }
 
     /// Fits one basis of `k` components.
@@ -203,8 +220,13 @@ impl BaselineMethod {
     }
 
     /// One basis at the largest of `ks`, each codec a truncation of it.
-    fn nested_codecs(basis: BaselineBasis, ks: &[usize]) -> Result<Vec<Box<dyn Codec>>> {
+    fn nested_codecs(&self, basis: BaselineBasis, ks: &[usize]) -> Result<Vec<Box<dyn Codec>>> {
         let basis = Arc::new(basis);
+        if self.keep_last {
+            if let Ok(mut slot) = self.last.lock() {
+                *slot = Some(Arc::clone(&basis));
+            }
+        }
         ks.iter().map(|&k| Ok(Box::new(basis.codec(k)?) as Box<dyn Codec>)).collect()
     }
 }
@@ -234,7 +256,7 @@ impl Method for BaselineMethod {
         progress: &dyn Progress,
     ) -> Result<Vec<Box<dyn Codec>>> {
         let k_max = max_k(ks)?;
-        Self::nested_codecs(self.fit_basis(train, k_max, progress)?, ks)
+        self.nested_codecs(self.fit_basis(train, k_max, progress)?, ks)
     }
 
     /// As [`Method::fit_ks`], reusing the fold's median reference for IPCA.
@@ -252,7 +274,7 @@ impl Method for BaselineMethod {
             max_k(ks)?,
             progress,
         )?;
-        Self::nested_codecs(basis, ks)
+        self.nested_codecs(basis, ks)
     }
 }
 
@@ -315,6 +337,7 @@ mod tests {
                 let one = codecs[0].decode(&codecs[0].encode(t).unwrap()).unwrap();
                 assert!(max_weighted_error(t, &one, &domain) > 1e-3);
             }
+            assert!(method.last_fit().is_none(), "kept a fit without being asked");
             assert!(codecs[0].decode(&[0.0, 0.0]).is_err());
             assert!(codecs[0].decode(&[f32::NAN]).is_err());
         }
@@ -322,15 +345,22 @@ mod tests {
 
     #[test]
     fn artifact_round_trips_and_rejects_corruption() {
-        let (_, tables) = sparse_set(4);
+        let (names, tables) = sparse_set(4);
         let refs: Vec<&MerlTable> = tables.iter().collect();
         let dir = tempfile::tempdir().unwrap();
         for method in [crate::pca::Pca::method(), crate::ipca::Ipca::method()] {
-            let basis = method.fit_basis(&refs, 2, &Silent).unwrap();
+            // The basis a harness fit keeps is the one saved (as `experiments baselines
+            // --save-basis` does).
+            let method = method.keeping_last_fit();
+            let codecs = method.fit_ks(&refs, &names, &[1, 2], &Silent).unwrap();
+            let basis = method.last_fit().unwrap();
+            assert_eq!(basis.basis().k(), 2);
+            let code = codecs[1].encode(&tables[1]).unwrap();
+            assert_eq!(code, basis.encode(&tables[1], 2).unwrap());
             let path = dir.path().join(format!("{}.basis", method.name()));
             basis.save(&path).unwrap();
             let back = BaselineBasis::load(&path).unwrap();
-            assert_eq!(back, basis);
+            assert_eq!(&back, basis.as_ref());
             let code = basis.encode(&tables[1], 2).unwrap();
             assert_eq!(back.decode(&code).unwrap(), basis.decode(&code).unwrap());
 
@@ -357,7 +387,26 @@ mod tests {
             absurd[k_at..k_at + 8].copy_from_slice(&u64::MAX.to_le_bytes());
             std::fs::write(&bad, &absurd).unwrap();
             let err = BaselineBasis::load(&bad).unwrap_err().to_string();
-            assert!(err.contains("absurd"), "{err}");
+            assert!(err.contains("absurd") && err.contains("flipped.basis"), "{err}");
+            // More components than the training set allows.
+            let mut inconsistent = bytes.clone();
+            inconsistent[k_at..k_at + 8].copy_from_slice(&4u64.to_le_bytes());
+            std::fs::write(&bad, &inconsistent).unwrap();
+            let err = BaselineBasis::load(&bad).unwrap_err().to_string();
+            assert!(err.contains("4 components from 4 training"), "{err}");
+            // A header claiming a larger (plausible) domain than the file holds.
+            let mut bigger = bytes.clone();
+            let cells_at = k_at - 8;
+            bigger[cells_at..cells_at + 8].copy_from_slice(&1_000_000u64.to_le_bytes());
+            std::fs::write(&bad, &bigger).unwrap();
+            let err = BaselineBasis::load(&bad).unwrap_err().to_string();
+            assert!(err.contains("header implies"), "{err}");
+            // A file that is a directory, and an empty file.
+            let err = BaselineBasis::load(dir.path()).unwrap_err().to_string();
+            assert!(err.contains("not a regular file"), "{err}");
+            std::fs::write(&bad, b"").unwrap();
+            let err = BaselineBasis::load(&bad).unwrap_err().to_string();
+            assert!(err.contains("too short"), "{err}");
         }
         let missing = BaselineBasis::load(&dir.path().join("none.basis")).unwrap_err().to_string();
         assert!(missing.contains("none.basis"), "{missing}");

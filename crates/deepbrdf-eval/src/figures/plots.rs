@@ -25,9 +25,13 @@ pub struct LineChart {
     pub y_label: String,
     pub log_y: bool,
     pub series: Vec<Series>,
-    /// Category names for integer x positions 0, 1, 2, ... (per-material charts); `None` for a
-    /// numeric x axis.
+    /// Category names for integer x positions 0, 1, 2, ... (materials, or k values); `None` for
+    /// a numeric x axis.
     pub categories: Option<Vec<String>>,
+    /// Draw category names vertically in a small font (many long names, e.g. materials).
+    pub rotate_categories: bool,
+    /// Put the legend in the upper left corner instead of the upper right.
+    pub legend_left: bool,
     /// Pixel size (width, height).
     pub size: (u32, u32),
 }
@@ -47,13 +51,26 @@ fn register_font() -> Result<()> {
 
 /// Writes `chart` to `<stem>.svg` and `<stem>.png` (each through a temp file and a rename).
 pub fn write_chart(chart: &LineChart, stem: &Path) -> Result<()> {
+    write_panels(std::slice::from_ref(chart), stem)
+}
+
+/// Writes `charts` stacked top to bottom in one figure (width: the widest; height: the sum) to
+/// `<stem>.svg` and `<stem>.png` (each through a temp file and a rename).
+pub fn write_panels(charts: &[LineChart], stem: &Path) -> Result<()> {
     register_font()?;
-    let (w, h) = chart.size;
+    if charts.is_empty() {
+        return Err(EvalError::Invalid(format!("{}: no chart to draw", stem.display())));
+    }
+    let w = charts.iter().map(|c| c.size.0).max().unwrap_or(1);
+    let h: u32 = charts.iter().map(|c| c.size.1).sum();
+    if u64::from(w) * u64::from(h) > 64_000_000 {
+        return Err(EvalError::Invalid(format!("{}: figure of {w} x {h} pixels", stem.display())));
+    }
     let svg_path = with_ext(stem, "svg");
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
-        draw(&root, chart)
+        draw_stacked(&root, charts)
             .map_err(|e| EvalError::Invalid(format!("{}: {e}", svg_path.display())))?;
         root.present().map_err(|e| EvalError::Invalid(format!("{}: {e}", svg_path.display())))?;
     }
@@ -63,7 +80,7 @@ pub fn write_chart(chart: &LineChart, stem: &Path) -> Result<()> {
     let mut buf = vec![255u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
-        draw(&root, chart)
+        draw_stacked(&root, charts)
             .map_err(|e| EvalError::Invalid(format!("{}: {e}", png_path.display())))?;
         root.present().map_err(|e| EvalError::Invalid(format!("{}: {e}", png_path.display())))?;
     }
@@ -73,6 +90,25 @@ pub fn write_chart(chart: &LineChart, stem: &Path) -> Result<()> {
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
         .map_err(|e| EvalError::Invalid(format!("{}: {e}", png_path.display())))?;
     write_atomic_file(&png_path, &png)
+}
+
+/// Draws each chart in its own horizontal band of `root`, top to bottom.
+fn draw_stacked<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    charts: &[LineChart],
+) -> DrawResult<DB> {
+    root.fill(&WHITE)?;
+    let mut rest = root.clone();
+    for (i, chart) in charts.iter().enumerate() {
+        if i + 1 == charts.len() {
+            draw(&rest, chart)?;
+        } else {
+            let (top, bottom) = rest.split_vertically(chart.size.1);
+            draw(&top, chart)?;
+            rest = bottom;
+        }
+    }
+    Ok(())
 }
 
 fn with_ext(stem: &Path, ext: &str) -> PathBuf {
@@ -107,6 +143,27 @@ const COLOURS: [RGBColor; 10] = [
     RGBColor(188, 189, 34),
     RGBColor(23, 190, 207),
 ];
+
+/// A y tick label: on a log axis only mantissas 1, 2 and 5 are labelled ("2e-3"), so labels
+/// never crowd; on a linear axis three significant digits.
+fn y_label(y: f64, log: bool) -> String {
+    if !log {
+        return format!("{y:.3}");
+    }
+    if !(y.is_finite() && y > 0.0) {
+        return String::new();
+    }
+    let exponent = y.log10().floor();
+    let mantissa = y / 10f64.powf(exponent);
+    for m in [1.0, 2.0, 5.0, 10.0] {
+        if (mantissa - m).abs() < 1e-6 * m {
+            let e = if m == 10.0 { exponent + 1.0 } else { exponent };
+            let m = if m == 10.0 { 1.0 } else { m };
+            return format!("{m}e{e}");
+        }
+    }
+    String::new()
+}
 
 type DrawResult<DB> =
     std::result::Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
@@ -143,7 +200,7 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &LineChart) ->
         y0 -= pad;
         y1 += pad;
     }
-    let bottom = if chart.categories.is_some() { 190 } else { 60 };
+    let bottom = if chart.rotate_categories { 190 } else { 60 };
     let mut builder = ChartBuilder::on(root);
     builder
         .caption(&chart.title, ("sans-serif", 26))
@@ -164,8 +221,8 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &LineChart) ->
         None => format!("{x}"),
     };
     let x_labels = chart.categories.as_ref().map(|c| c.len()).unwrap_or(12);
-    let x_style = if chart.categories.is_some() {
-        TextStyle::from(("sans-serif", 11).into_font()).transform(FontTransform::Rotate90)
+    let x_style = if chart.rotate_categories {
+        TextStyle::from(("sans-serif", 12).into_font()).transform(FontTransform::Rotate90)
     } else {
         TextStyle::from(("sans-serif", 16).into_font())
     };
@@ -181,7 +238,10 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &LineChart) ->
                 .x_label_formatter(&x_fmt)
                 .x_label_style(x_style.clone())
                 .y_label_style(("sans-serif", 15))
-                .y_label_formatter(&|y: &f64| format!("{y:.3e}"))
+                .y_labels(if chart.log_y { 30 } else { 10 })
+                .light_line_style(TRANSPARENT)
+                .bold_line_style(BLACK.mix(0.12))
+                .y_label_formatter(&|y: &f64| y_label(*y, chart.log_y))
                 .draw()?;
             for (i, s) in chart.series.iter().enumerate() {
                 let colour = COLOURS[i % COLOURS.len()];
@@ -198,7 +258,11 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &LineChart) ->
                 .background_style(WHITE.mix(0.85))
                 .border_style(BLACK)
                 .label_font(("sans-serif", 16))
-                .position(SeriesLabelPosition::UpperRight)
+                .position(if chart.legend_left {
+                    SeriesLabelPosition::UpperLeft
+                } else {
+                    SeriesLabelPosition::UpperRight
+                })
                 .draw()?;
         }};
     }
@@ -213,6 +277,17 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &LineChart) ->
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn log_axis_labels_only_one_two_five() {
+        assert_eq!(y_label(0.01, true), "1e-2");
+        assert_eq!(y_label(2e-3, true), "2e-3");
+        assert_eq!(y_label(5e4, true), "5e4");
+        assert_eq!(y_label(3e-3, true), "");
+        assert_eq!(y_label(9.9999999999e-3, true), "1e-2");
+        assert_eq!(y_label(0.0, true), "");
+        assert_eq!(y_label(0.25, false), "0.250");
+    }
 
     #[test]
     fn writes_svg_and_png_with_text() {
@@ -230,6 +305,8 @@ mod tests {
                 },
             ],
             categories: None,
+            rotate_categories: false,
+            legend_left: false,
             size: (640, 420),
         };
         let stem = dir.path().join("chart");

@@ -3,7 +3,7 @@
 //! coefficients per BRDF. Both traits are object safe (`&dyn Method`, `Box<dyn Codec>`).
 
 use crate::error::Result;
-use crate::median_reference::MedianReference;
+use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::{MerlTable, Progress};
 
 /// The training side of one fold as the harness hands it to a [`Method`].

@@ -3,7 +3,7 @@
 
 use crate::error::{EvalError, Result};
 use crate::ipca;
-use crate::median_reference::{log_relative, MedianReference};
+use deepbrdf_data::mapping::{log_relative, MedianReference};
 use deepbrdf_data::merl::{CELLS, VALUES};
 use deepbrdf_data::MerlTable;
 use rayon::prelude::*;

@@ -7,8 +7,8 @@ mod measures;
 mod modes;
 mod report;
 
-pub use crate::median_reference::MedianReference;
 pub use codec::{Codec, Method, TrainingSet};
+pub use deepbrdf_data::mapping::MedianReference;
 pub use measures::{Measure, Original, Yardstick};
 pub use modes::{Fold, Mode};
 pub use report::{FitTiming, Record, Results};

@@ -5,7 +5,7 @@
 use super::measures::Measure;
 use super::modes::Mode;
 use crate::error::{EvalError, Result};
-use crate::figures::{write_chart, LineChart, Series};
+use crate::figures::{write_chart, write_panels, LineChart, Series};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -129,7 +129,8 @@ impl Results {
     /// The markdown summary: settings, the tables, fit timings, the plots.
     pub fn summary_markdown(&self) -> String {
         let mut s = String::new();
-        let _ = writeln!(s, "# Baselines: {} mode\n", self.mode);
+        let _ = writeln!(s, "# Reconstruction error: {} mode\n", self.mode);
+        let _ = writeln!(s, "- methods: {}", self.methods.join(", "));
         let _ = writeln!(s, "- training data: {}", self.train_label);
         let _ = writeln!(s, "- evaluation data: {}", self.eval_label);
         let _ = writeln!(s, "- k: {:?}, seed: {}", self.ks, self.seed);
@@ -138,7 +139,10 @@ impl Results {
             "- measures over valid cells only; eq. (1) reference = per-value median of the training tables of each fold\n"
         );
         s.push_str(&self.summary_table());
-        let _ = writeln!(s, "Fit times (all k from one fit per method and fold):\n");
+        let _ = writeln!(
+            s,
+            "Fit times (per method and fold, all k; PCA and IPCA fit once for all k):\n"
+        );
         let _ =
             writeln!(s, "| method | fold | training materials | seconds |\n|---|---:|---:|---:|");
         for f in &self.fits {
@@ -151,6 +155,7 @@ impl Results {
         );
         for &m in &self.measures {
             let _ = writeln!(s, "![{} vs k](error_vs_k_{}.png)\n", m.label(), m.name());
+            let _ = writeln!(s, "![{} per material](per_material_{}.png)\n", m.label(), m.name());
         }
         s
     }
@@ -190,58 +195,102 @@ impl Results {
             self.summary_markdown().as_bytes(),
         )?;
 
-        let materials = self.materials();
         for &m in &self.measures {
-            let series = self
-                .methods
-                .iter()
-                .map(|method| Series {
-                    label: method.clone(),
-                    points: self
-                        .ks
-                        .iter()
-                        .filter_map(|&k| self.mean(method, k, m).map(|v| (k as f64, v)))
-                        .collect(),
-                })
-                .collect();
-            let chart = LineChart {
-                title: format!("{} vs k ({})", m.label(), self.mode),
-                x_label: "k (dimension of the representation)".into(),
-                y_label: format!("mean {}", m.label()),
-                log_y: true,
-                series,
-                categories: None,
-                size: (900, 600),
-            };
-            write_chart(&chart, &dir.join(format!("error_vs_k_{}", m.name())))?;
-
-            let mut series = Vec::new();
-            for method in &self.methods {
-                for &k in &self.ks {
-                    series.push(Series {
-                        label: format!("{method} k={k}"),
-                        points: self
-                            .per_material(method, k, m, &materials)
-                            .into_iter()
-                            .enumerate()
-                            .map(|(i, v)| (i as f64, v))
-                            .collect(),
-                    });
-                }
-            }
-            let width = (400 + 16 * materials.len() as u32).clamp(900, 2400);
-            let chart = LineChart {
-                title: format!("{} per material ({})", m.label(), self.mode),
-                x_label: "material".into(),
-                y_label: m.label().into(),
-                log_y: true,
-                series,
-                categories: Some(materials.clone()),
-                size: (width, 760),
-            };
-            write_chart(&chart, &dir.join(format!("per_material_{}", m.name())))?;
+            write_chart(&self.error_vs_k_chart(m), &dir.join(format!("error_vs_k_{}", m.name())))?;
+            write_panels(
+                &self.per_material_charts(m),
+                &dir.join(format!("per_material_{}", m.name())),
+            )?;
         }
         Ok(())
+    }
+
+    /// Fig. 3: the mean of `measure` against k, one line per method, log scale. The k values
+    /// are evenly spaced categories (the usual 5, 10, 20, 40 double at each step).
+    pub fn error_vs_k_chart(&self, measure: Measure) -> LineChart {
+        let series = self
+            .methods
+            .iter()
+            .map(|method| Series {
+                label: method.clone(),
+                points: self
+                    .ks
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(i, &k)| self.mean(method, k, measure).map(|v| (i as f64, v)))
+                    .collect(),
+            })
+            .collect();
+        LineChart {
+            title: format!("{} vs k ({}, {})", measure.label(), self.mode, self.eval_label),
+            x_label: "k (dimension of the representation)".into(),
+            y_label: format!("mean {}", measure.label()),
+            log_y: true,
+            series,
+            categories: Some(self.ks.iter().map(|k| k.to_string()).collect()),
+            rotate_categories: false,
+            legend_left: false,
+            size: (900, 600),
+        }
+    }
+
+    /// Fig. 7: per-material values of `measure`, one panel per k, one line per method; in each
+    /// panel the materials are sorted by the geometric mean of the methods' values at that k,
+    /// so the panel reads from the easiest material to the hardest and the lines can be compared
+    /// material by material.
+    pub fn per_material_charts(&self, measure: Measure) -> Vec<LineChart> {
+        let materials = self.materials();
+        let width = (300 + 14 * materials.len() as u32).clamp(900, 2600);
+        self.ks
+            .iter()
+            .map(|&k| {
+                let values: Vec<Vec<f64>> = self
+                    .methods
+                    .iter()
+                    .map(|method| self.per_material(method, k, measure, &materials))
+                    .collect();
+                let mut order: Vec<usize> = (0..materials.len()).collect();
+                let key = |i: usize| {
+                    let logs: Vec<f64> = values
+                        .iter()
+                        .map(|v| v[i])
+                        .filter(|v| v.is_finite() && *v > 0.0)
+                        .map(f64::ln)
+                        .collect();
+                    if logs.is_empty() {
+                        f64::INFINITY
+                    } else {
+                        logs.iter().sum::<f64>() / logs.len() as f64
+                    }
+                };
+                order.sort_by(|&a, &b| key(a).total_cmp(&key(b)));
+                let series = self
+                    .methods
+                    .iter()
+                    .zip(&values)
+                    .map(|(method, v)| Series {
+                        label: format!("{method}, k = {k}"),
+                        points: order.iter().enumerate().map(|(x, &i)| (x as f64, v[i])).collect(),
+                    })
+                    .collect();
+                LineChart {
+                    title: format!(
+                        "{} per material, k = {k} ({}, {}; sorted by the methods' geometric mean)",
+                        measure.label(),
+                        self.mode,
+                        self.eval_label
+                    ),
+                    x_label: "material".into(),
+                    y_label: measure.label().into(),
+                    log_y: true,
+                    series,
+                    categories: Some(order.iter().map(|&i| materials[i].clone()).collect()),
+                    rotate_categories: true,
+                    legend_left: true,
+                    size: (width, 640),
+                }
+            })
+            .collect()
     }
 }
 
@@ -250,5 +299,88 @@ fn csv_field(s: &str) -> String {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {
         s.to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Results shaped like a DeepBRDF sweep: 3 methods x 4 k x `n` materials, two measures.
+    pub(crate) fn fake_results(n: usize) -> Results {
+        let methods = ["PCA", "IPCA", "DeepBRDF"];
+        let ks = vec![5, 10, 20, 40];
+        let mut records = Vec::new();
+        for (mi, method) in methods.iter().enumerate() {
+            for &k in &ks {
+                for i in 0..n {
+                    for measure in Measure::ALL {
+                        let hardness = 1.0 + ((i * 37) % n) as f64 / n as f64 * 20.0;
+                        let value = hardness * 1e-2 / (1.0 + mi as f64) / k as f64;
+                        records.push(Record {
+                            method: method.to_string(),
+                            k,
+                            fold: i % 5,
+                            material: format!("material-{i:03}"),
+                            measure,
+                            value,
+                        });
+                    }
+                }
+            }
+        }
+        Results {
+            mode: Mode::KFold { folds: 5 },
+            seed: 3,
+            ks,
+            methods: methods.iter().map(|m| m.to_string()).collect(),
+            measures: Measure::ALL.to_vec(),
+            train_label: "fake (100)".into(),
+            eval_label: "fake (100)".into(),
+            records,
+            fits: vec![FitTiming { method: "PCA".into(), fold: 0, n_train: 80, seconds: 1.5 }],
+            eval_seconds: 1.0,
+            total_seconds: 2.5,
+        }
+    }
+
+    #[test]
+    fn three_methods_four_ks_hundred_materials_make_readable_figures() {
+        let results = fake_results(100);
+        assert_eq!(results.mean("DeepBRDF", 40, Measure::MappedMse).map(|v| v > 0.0), Some(true));
+        // Fig. 7: one panel per k, one line per method, materials sorted by error.
+        let panels = results.per_material_charts(Measure::MappedMse);
+        assert_eq!(panels.len(), 4);
+        for (panel, k) in panels.iter().zip([5, 10, 20, 40]) {
+            assert_eq!(panel.series.len(), 3);
+            assert!(panel.title.contains(&format!("k = {k}")));
+            let names = panel.categories.as_ref().map_or(0, |c| c.len());
+            assert_eq!(names, 100);
+            // Every method's values increase along the sorted axis in this fake data (they are
+            // proportional to one another), so sorting by the geometric mean sorts each.
+            for s in &panel.series {
+                assert!(s.points.windows(2).all(|w| w[0].1 <= w[1].1), "{}", s.label);
+            }
+        }
+        let chart = results.error_vs_k_chart(Measure::CosRmse);
+        assert_eq!(chart.series.len(), 3);
+        assert_eq!(chart.categories, Some(vec!["5".into(), "10".into(), "20".into(), "40".into()]));
+
+        let dir = tempfile::tempdir().unwrap();
+        results.write(dir.path()).unwrap();
+        let png = image::open(dir.path().join("per_material_mapped_mse.png")).unwrap();
+        assert_eq!((png.width(), png.height()), (1700, 4 * 640));
+        let md = std::fs::read_to_string(dir.path().join("summary.md")).unwrap();
+        assert!(md.contains("| DeepBRDF |") && md.contains("per_material_cos_rmse.png"), "{md}");
+        let csv = std::fs::read_to_string(dir.path().join("results.csv")).unwrap();
+        assert_eq!(csv.lines().count(), 1 + 3 * 4 * 100 * 2);
+        // Rewriting into the same folder replaces the files and leaves no temporary file.
+        results.write(dir.path()).unwrap();
+        let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .filter_map(|e| e.ok())
+            .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
+            .collect();
+        assert!(leftovers.is_empty(), "{leftovers:?}");
     }
 }

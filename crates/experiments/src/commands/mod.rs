@@ -4,6 +4,7 @@ use crate::progress::Bars;
 
 pub mod bench;
 pub mod devices;
+pub mod fetch_merl;
 pub mod info;
 pub mod pack_nbrdf;
 pub mod tabulate;
@@ -16,5 +17,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Info(args) => info::run(args, &progress),
         Command::Tabulate(args) => tabulate::run(args, &progress),
         Command::PackNbrdf(args) => pack_nbrdf::run(args, &progress),
+        Command::FetchMerl(args) => fetch_merl::run(args, cli.quiet),
     }
 }

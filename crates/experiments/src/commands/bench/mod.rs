@@ -2,6 +2,8 @@
 //! checked by these commands, not by timed tests).
 use deepbrdf_data::Progress;
 
+pub mod io;
+pub mod lookup;
 pub mod tabulate;
 
 #[derive(Debug, clap::Args)]
@@ -15,10 +17,16 @@ pub struct Args {
 pub enum What {
     /// Tabulating bundled NBRDF networks onto the MERL grid (target: 100 materials < 30 s).
     Tabulate(tabulate::Args),
+    /// MERL .binary read and write speed (target: reading a 35 MB file well under 0.5 s).
+    Io(io::Args),
+    /// MERL table lookup speed, nearest and interpolated, one thread.
+    Lookup(lookup::Args),
 }
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     match args.what {
         What::Tabulate(a) => tabulate::run(a, progress),
+        What::Io(a) => io::run(a, progress),
+        What::Lookup(a) => lookup::run(a, progress),
     }
 }
