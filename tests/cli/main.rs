@@ -1,4 +1,6 @@
 //! End-to-end tests of the `experiments` command line, compiled as one test binary.
 mod util;
 
+mod data;
 mod devices;
+mod fetch_merl;

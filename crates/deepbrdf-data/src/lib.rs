@@ -12,6 +12,7 @@ pub mod merl;
 pub mod nbrdf;
 pub mod progress;
 pub mod summary;
+pub mod testing;
 
 pub use error::{DataError, Result};
 pub use merl::MerlTable;

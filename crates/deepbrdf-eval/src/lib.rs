@@ -5,6 +5,7 @@ pub mod error;
 pub mod figures;
 pub mod harness;
 pub mod ipca;
+pub mod metrics;
 pub mod pca;
 pub mod render;
 #[cfg(test)]

@@ -17,4 +17,15 @@ pub struct Cli {
 pub enum Command {
     /// List the compute devices compiled into this binary.
     Devices(commands::devices::Args),
+    /// Benchmarks that print speed numbers.
+    Bench(commands::bench::Args),
+    /// Download the official MERL BRDF database (100 `.binary` files), verified by SHA-256.
+    FetchMerl(commands::fetch_merl::Args),
+    /// Describe a MERL table: a .binary file or a bundled material (header, valid cells,
+    /// per-channel statistics, albedo at normal incidence).
+    Info(commands::info::Args),
+    /// Write MERL .binary files tabulated from the bundled NBRDF networks.
+    Tabulate(commands::tabulate::Args),
+    /// Pack folders of JSON NBRDF networks into the bundled .nbrdf files.
+    PackNbrdf(commands::pack_nbrdf::Args),
 }

@@ -1,6 +1,7 @@
 //! `experiments`: the DeepBRDF command line. Thin: parse, dispatch, print the error chain.
 mod cli;
 mod commands;
+mod data_args;
 mod progress;
 
 use clap::Parser;

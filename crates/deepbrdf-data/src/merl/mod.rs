@@ -1,6 +1,9 @@
-//! The MERL BRDF format (Matusik et al. 2003): grid, table, file I/O.
+//! The MERL BRDF format (Matusik et al. 2003): grid, table, file I/O, Rusinkiewicz coordinates,
+//! lookup.
+pub mod coords;
 pub mod grid;
 pub mod io;
+pub mod lookup;
 pub mod table;
 
 pub use io::{read_merl, write_merl, MerlFile};

@@ -153,25 +153,31 @@ fn shade(
     };
     let u0: f64 = rng.random();
     let u = [rng.random::<f64>(), rng.random::<f64>()];
-    let (wi, wi_world, radiance, pdf_light) = if u0 < LIGHT_STRATEGY_PROB {
+    // The BRDF lookup (a likely cache miss in a tabulated BRDF) is issued as soon as wi is
+    // known, so the processor overlaps it with the environment's and the pdfs' arithmetic.
+    let (wi, wi_world, f, radiance, pdf_light) = if u0 < LIGHT_STRATEGY_PROB {
         let (dir, radiance, pdf) = env.sample(u);
-        (frame.to_local(dir), dir, radiance, pdf)
+        let wi = frame.to_local(dir);
+        if wi.z <= 0.0 || radiance.iter().all(|&v| v <= 0.0) {
+            return out;
+        }
+        (wi, dir, brdf.eval(wi, wo), radiance, pdf)
     } else {
         let Some(wi) = brdf.sample(wo, u) else {
             return out;
         };
         let dir = frame.to_world(wi);
+        if wi.z <= 0.0 || env.is_dark(dir) {
+            return out;
+        }
+        let f = brdf.eval(wi, wo);
         let (radiance, pdf) = env.eval(dir);
-        (wi, dir, radiance, pdf)
+        (wi, dir, f, radiance, pdf)
     };
-    if wi.z <= 0.0 || radiance.iter().all(|&v| v <= 0.0) {
-        return out;
-    }
     let pdf = LIGHT_STRATEGY_PROB * pdf_light + (1.0 - LIGHT_STRATEGY_PROB) * brdf.pdf(wi, wo);
     if !(pdf > 0.0) || shape.occludes(point, frame.n, wi_world) {
         return out;
     }
-    let f = brdf.eval(wi, wo);
     let w = wi.z / pdf;
     for c in 0..3 {
         out[c] += f[c] * radiance[c] * w;

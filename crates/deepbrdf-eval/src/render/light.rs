@@ -54,6 +54,16 @@ impl Environment {
         }
     }
 
+    /// Whether no light at all arrives from `dir` (a cheap test: below the sky's horizon and
+    /// outside the sun).
+    #[inline]
+    pub fn is_dark(&self, dir: Vec3) -> bool {
+        match self {
+            Self::Constant(l) => l.iter().all(|&v| v <= 0.0),
+            Self::SunSky(s) => dir.z <= 0.0 && !s.in_sun(dir),
+        }
+    }
+
     /// Radiance from `dir` and the density of [`Environment::sample`] there, together.
     #[inline]
     pub fn eval(&self, dir: Vec3) -> (Rgb, f64) {

@@ -20,7 +20,7 @@ pub mod shape;
 pub mod sheet;
 pub mod sky;
 
-pub use brdf::{Brdf, Ggx, Lambertian, SamplingLobe, Sum};
+pub use brdf::{Brdf, Ggx, Lambertian, MerlBrdf, MerlLookup, SamplingLobe, Sum};
 pub use camera::{Camera, Projection};
 pub use image::{Image, Srgb8Image, Tonemap};
 pub use integrator::{render, RenderSettings};

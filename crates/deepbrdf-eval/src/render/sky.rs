@@ -318,8 +318,9 @@ impl SunSky {
         (col, row)
     }
 
+    /// Whether `dir` lies in the sun disk.
     #[inline]
-    fn in_sun(&self, dir: Vec3) -> bool {
+    pub fn in_sun(&self, dir: Vec3) -> bool {
         dir.dot(self.sun) >= self.cos_sun_radius
     }
 

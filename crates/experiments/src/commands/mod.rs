@@ -2,11 +2,21 @@
 use crate::cli::{Cli, Command};
 use crate::progress::Bars;
 
+pub mod bench;
 pub mod devices;
+pub mod fetch_merl;
+pub mod info;
+pub mod pack_nbrdf;
+pub mod tabulate;
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     let progress = Bars::new(cli.quiet);
     match cli.command {
         Command::Devices(args) => devices::run(args, &progress),
+        Command::Bench(args) => bench::run(args, &progress),
+        Command::FetchMerl(args) => fetch_merl::run(args, cli.quiet),
+        Command::Info(args) => info::run(args, &progress),
+        Command::Tabulate(args) => tabulate::run(args, &progress),
+        Command::PackNbrdf(args) => pack_nbrdf::run(args, &progress),
     }
 }

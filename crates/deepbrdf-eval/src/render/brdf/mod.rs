@@ -7,15 +7,17 @@
 //! light and `wo` towards the viewer, the argument order of `MerlTable::lookup_interpolated`.
 
 mod ggx;
+mod interleaved;
 mod lambertian;
 mod lobe;
-// mod merl;
+mod merl;
 mod sum;
 
 pub use ggx::Ggx;
+pub use interleaved::InterleavedTable;
 pub use lambertian::Lambertian;
 pub use lobe::SamplingLobe;
-// pub use merl::{MerlBrdf, MerlLookup};
+pub use merl::{MerlBrdf, MerlLookup};
 pub use sum::Sum;
 
 use super::geometry::Vec3;

@@ -1,0 +1,32 @@
+//! `experiments bench ...`: benchmarks that print speed numbers (the project's speed targets are
+//! checked by these commands, not by timed tests).
+use deepbrdf_data::Progress;
+
+pub mod io;
+pub mod lookup;
+pub mod tabulate;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(subcommand)]
+    pub what: What,
+}
+
+/// What to benchmark.
+#[derive(Debug, clap::Subcommand)]
+pub enum What {
+    /// MERL .binary read and write speed (target: reading a 35 MB file well under 0.5 s).
+    Io(io::Args),
+    /// MERL table lookup speed, nearest and interpolated, one thread.
+    Lookup(lookup::Args),
+    /// Tabulating bundled NBRDF networks onto the MERL grid (target: 100 materials < 30 s).
+    Tabulate(tabulate::Args),
+}
+
+pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
+    match args.what {
+        What::Io(a) => io::run(a, progress),
+        What::Lookup(a) => lookup::run(a, progress),
+        What::Tabulate(a) => tabulate::run(a, progress),
+    }
+}

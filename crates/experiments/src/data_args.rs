@@ -1,0 +1,70 @@
+//! The data-selection arguments shared by commands that work on a dataset:
+//! `--collection NAME` (a bundled collection, default `merl`), `--data DIR` (a folder of MERL
+//! `.binary` files instead) and `--cache DIR` (where tabulated tables are kept).
+use anyhow::Context;
+use deepbrdf_data::bundled::Collection;
+use deepbrdf_data::cache::Cache;
+use deepbrdf_data::dataset::{DataSource, Dataset};
+use deepbrdf_data::Progress;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Clone, clap::Args)]
+pub struct DataArgs {
+    /// Bundled collection of materials: merl (100), nielsen2015 (8) or rgl (51).
+    #[arg(long, value_name = "NAME", default_value = "merl", conflicts_with = "data")]
+    pub collection: Collection,
+    /// Folder of MERL .binary files to use instead of a bundled collection (e.g. the real MERL
+    /// database).
+    #[arg(long, value_name = "DIR")]
+    pub data: Option<PathBuf>,
+    #[command(flatten)]
+    pub cache: CacheArg,
+}
+
+/// `--cache DIR`, for commands that tabulate bundled materials.
+#[derive(Debug, Clone, clap::Args)]
+pub struct CacheArg {
+    /// Cache directory for tabulated bundled materials
+    /// [default: $DEEPBRDF_CACHE, else the platform cache directory + deepbrdf].
+    #[arg(long = "cache", value_name = "DIR")]
+    pub dir: Option<PathBuf>,
+}
+
+impl CacheArg {
+    /// The cache this argument selects.
+    pub fn cache(&self) -> Cache {
+        cache_at(self.dir.as_deref())
+    }
+}
+
+/// The cache in `dir`, or the default location.
+pub fn cache_at(dir: Option<&Path>) -> Cache {
+    match dir {
+        Some(d) => Cache::at(d),
+        None => Cache::default_location(),
+    }
+}
+
+// The training and baseline commands flatten `DataArgs`; until they land nothing here calls it.
+#[allow(dead_code)]
+impl DataArgs {
+    /// Where the data come from.
+    pub fn source(&self) -> DataSource {
+        match &self.data {
+            Some(dir) => DataSource::Folder(dir.clone()),
+            None => DataSource::Bundled(self.collection),
+        }
+    }
+
+    /// The cache of tabulated tables.
+    pub fn cache(&self) -> Cache {
+        self.cache.cache()
+    }
+
+    /// Loads the selected dataset.
+    pub fn load(&self, progress: &dyn Progress) -> anyhow::Result<Dataset> {
+        let source = self.source();
+        Dataset::load(&source, &self.cache(), progress)
+            .with_context(|| format!("loading the dataset {}", source.label()))
+    }
+}
