@@ -2,6 +2,8 @@
 mod cli;
 mod commands;
 mod data_args;
+mod device_arg;
+mod latent_file;
 mod progress;
 
 use clap::Parser;

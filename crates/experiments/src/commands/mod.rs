@@ -3,14 +3,19 @@ use crate::cli::{Cli, Command};
 use crate::progress::Bars;
 
 pub mod bench;
+pub mod decode;
 pub mod devices;
+pub mod encode;
 pub mod fetch_merl;
 pub mod info;
 pub mod pack_nbrdf;
+pub mod reconstruct;
 pub mod tabulate;
+pub mod train;
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     let progress = Bars::new(cli.quiet);
+    crate::device_arg::select(cli.device);
     match cli.command {
         Command::Devices(args) => devices::run(args, &progress),
         Command::Bench(args) => bench::run(args, &progress),
@@ -18,5 +23,9 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Info(args) => info::run(args, &progress),
         Command::Tabulate(args) => tabulate::run(args, &progress),
         Command::PackNbrdf(args) => pack_nbrdf::run(args, &progress),
+        Command::Train(args) => train::run(args, &progress),
+        Command::Encode(args) => encode::run(args, &progress),
+        Command::Decode(args) => decode::run(args, &progress),
+        Command::Reconstruct(args) => reconstruct::run(args, &progress),
     }
 }
