@@ -39,6 +39,8 @@ pub enum Command {
     Decode(commands::decode::Args),
     /// Encode and decode a BRDF, optionally from 1/3 or 1/9 of its slices (Fig. 2).
     Reconstruct(commands::reconstruct::Args),
+    /// The main job: DeepBRDF, PCA and IPCA at each k (Figs. 2, 3 and 7), tables and plots.
+    SweepK(commands::sweep_k::Args),
 }
 
 fn parse_device(s: &str) -> Result<deepbrdf_model::DeviceKind, String> {

@@ -10,6 +10,7 @@ pub mod fetch_merl;
 pub mod info;
 pub mod pack_nbrdf;
 pub mod reconstruct;
+pub mod sweep_k;
 pub mod tabulate;
 pub mod train;
 
@@ -27,5 +28,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Encode(args) => encode::run(args, &progress),
         Command::Decode(args) => decode::run(args, &progress),
         Command::Reconstruct(args) => reconstruct::run(args, &progress),
+        Command::SweepK(args) => sweep_k::run(args, cli.quiet, &progress),
     }
 }
