@@ -28,4 +28,11 @@ pub enum Command {
     Tabulate(commands::tabulate::Args),
     /// Pack folders of JSON NBRDF networks into the bundled .nbrdf files.
     PackNbrdf(commands::pack_nbrdf::Args),
+    /// Render a material (a MERL .binary file or a bundled material) to PNG and EXR.
+    Render(commands::render::Args),
+    /// Render two materials under the same settings; print RelAE, RMSE and PSNR and write a
+    /// false-colour difference image.
+    Compare(commands::compare::Args),
+    /// Render every material of a dataset on spheres, in one captioned contact sheet.
+    Sheet(commands::sheet::Args),
 }

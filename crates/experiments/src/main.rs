@@ -3,6 +3,7 @@ mod cli;
 mod commands;
 mod data_args;
 mod progress;
+mod scene_args;
 
 use clap::Parser;
 use std::process::ExitCode;

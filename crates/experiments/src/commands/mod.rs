@@ -3,10 +3,13 @@ use crate::cli::{Cli, Command};
 use crate::progress::Bars;
 
 pub mod bench;
+pub mod compare;
 pub mod devices;
 pub mod fetch_merl;
 pub mod info;
 pub mod pack_nbrdf;
+pub mod render;
+pub mod sheet;
 pub mod tabulate;
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
@@ -18,5 +21,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Info(args) => info::run(args, &progress),
         Command::Tabulate(args) => tabulate::run(args, &progress),
         Command::PackNbrdf(args) => pack_nbrdf::run(args, &progress),
+        Command::Render(args) => render::run(args, &progress),
+        Command::Compare(args) => compare::run(args, &progress),
+        Command::Sheet(args) => sheet::run(args, &progress),
     }
 }
