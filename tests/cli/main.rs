@@ -4,3 +4,4 @@ mod util;
 mod data;
 mod devices;
 mod fetch_merl;
+mod render;

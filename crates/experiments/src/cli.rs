@@ -43,4 +43,11 @@ pub enum Command {
 
 fn parse_device(s: &str) -> Result<deepbrdf_model::DeviceKind, String> {
     s.parse()
+    /// Render a material (a MERL .binary file or a bundled material) to PNG and EXR.
+    Render(commands::render::Args),
+    /// Render two materials under the same settings; print RelAE, RMSE and PSNR and write a
+    /// false-colour difference image.
+    Compare(commands::compare::Args),
+    /// Render every material of a dataset on spheres, in one captioned contact sheet.
+    Sheet(commands::sheet::Args),
 }

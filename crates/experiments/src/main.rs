@@ -5,6 +5,7 @@ mod data_args;
 mod device_arg;
 mod latent_file;
 mod progress;
+mod scene_args;
 
 use clap::Parser;
 use std::process::ExitCode;

@@ -4,12 +4,15 @@ use crate::progress::Bars;
 
 pub mod bench;
 pub mod decode;
+pub mod compare;
 pub mod devices;
 pub mod encode;
 pub mod fetch_merl;
 pub mod info;
 pub mod pack_nbrdf;
 pub mod reconstruct;
+pub mod render;
+pub mod sheet;
 pub mod tabulate;
 pub mod train;
 
@@ -27,5 +30,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Encode(args) => encode::run(args, &progress),
         Command::Decode(args) => decode::run(args, &progress),
         Command::Reconstruct(args) => reconstruct::run(args, &progress),
+        Command::Render(args) => render::run(args, &progress),
+        Command::Compare(args) => compare::run(args, &progress),
+        Command::Sheet(args) => sheet::run(args, &progress),
     }
 }
