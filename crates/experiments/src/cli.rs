@@ -39,10 +39,6 @@ pub enum Command {
     Decode(commands::decode::Args),
     /// Encode and decode a BRDF, optionally from 1/3 or 1/9 of its slices (Fig. 2).
     Reconstruct(commands::reconstruct::Args),
-}
-
-fn parse_device(s: &str) -> Result<deepbrdf_model::DeviceKind, String> {
-    s.parse()
     /// Render a material (a MERL .binary file or a bundled material) to PNG and EXR.
     Render(commands::render::Args),
     /// Render two materials under the same settings; print RelAE, RMSE and PSNR and write a
@@ -50,4 +46,8 @@ fn parse_device(s: &str) -> Result<deepbrdf_model::DeviceKind, String> {
     Compare(commands::compare::Args),
     /// Render every material of a dataset on spheres, in one captioned contact sheet.
     Sheet(commands::sheet::Args),
+}
+
+fn parse_device(s: &str) -> Result<deepbrdf_model::DeviceKind, String> {
+    s.parse()
 }

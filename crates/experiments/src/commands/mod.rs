@@ -3,8 +3,8 @@ use crate::cli::{Cli, Command};
 use crate::progress::Bars;
 
 pub mod bench;
-pub mod decode;
 pub mod compare;
+pub mod decode;
 pub mod devices;
 pub mod encode;
 pub mod fetch_merl;
