@@ -4,4 +4,5 @@ mod util;
 mod data;
 mod devices;
 mod fetch_merl;
+mod render;
 mod sweep_k;

@@ -41,6 +41,13 @@ pub enum Command {
     Reconstruct(commands::reconstruct::Args),
     /// The main job: DeepBRDF, PCA and IPCA at each k (Figs. 2, 3 and 7), tables and plots.
     SweepK(commands::sweep_k::Args),
+    /// Render a material (a MERL .binary file or a bundled material) to PNG and EXR.
+    Render(commands::render::Args),
+    /// Render two materials under the same settings; print RelAE, RMSE and PSNR and write a
+    /// false-colour difference image.
+    Compare(commands::compare::Args),
+    /// Render every material of a dataset on spheres, in one captioned contact sheet.
+    Sheet(commands::sheet::Args),
 }
 
 fn parse_device(s: &str) -> Result<deepbrdf_model::DeviceKind, String> {

@@ -11,6 +11,7 @@ mod progress;
 mod progress_log;
 mod readme_block;
 mod robustness;
+mod scene_args;
 mod slices_figure;
 
 use clap::Parser;

@@ -3,6 +3,7 @@ use crate::cli::{Cli, Command};
 use crate::progress::Bars;
 
 pub mod bench;
+pub mod compare;
 pub mod decode;
 pub mod devices;
 pub mod encode;
@@ -10,6 +11,8 @@ pub mod fetch_merl;
 pub mod info;
 pub mod pack_nbrdf;
 pub mod reconstruct;
+pub mod render;
+pub mod sheet;
 pub mod sweep_k;
 pub mod tabulate;
 pub mod train;
@@ -29,5 +32,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Decode(args) => decode::run(args, &progress),
         Command::Reconstruct(args) => reconstruct::run(args, &progress),
         Command::SweepK(args) => sweep_k::run(args, cli.quiet, &progress),
+        Command::Render(args) => render::run(args, &progress),
+        Command::Compare(args) => compare::run(args, &progress),
+        Command::Sheet(args) => sheet::run(args, &progress),
     }
 }

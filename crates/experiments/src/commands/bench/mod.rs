@@ -5,6 +5,7 @@ use deepbrdf_data::Progress;
 pub mod io;
 pub mod lookup;
 pub mod model;
+pub mod render;
 pub mod tabulate;
 
 #[derive(Debug, clap::Args)]
@@ -25,6 +26,9 @@ pub enum What {
     /// DeepBRDF training seconds per BRDF (cpu and paper presets) and decode seconds
     /// (target: decoding <= 0.15 s on 2 cores).
     Model(model::Args),
+    /// Renderer speed: MERL lookups per second and images per second (target: a 256x256 sphere
+    /// of a tabulated MERL material under sun and sky at 64 spp in < 0.5 s on 2 cores).
+    Render(render::Args),
 }
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
@@ -33,5 +37,6 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         What::Lookup(a) => lookup::run(a, progress),
         What::Tabulate(a) => tabulate::run(a, progress),
         What::Model(a) => model::run(a, progress),
+        What::Render(a) => render::run(a, progress),
     }
 }

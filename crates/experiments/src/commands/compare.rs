@@ -1,0 +1,61 @@
+//! `experiments compare`: renders two materials under the same settings, prints RelAE (the
+//! paper's image-space error), RMSE and PSNR of the tonemapped images, and writes a false-colour
+//! difference image.
+use crate::data_args::CacheArg;
+use crate::scene_args::SceneArgs;
+use anyhow::Context;
+use deepbrdf_data::dataset::load_material;
+use deepbrdf_data::Progress;
+use deepbrdf_eval::metrics::{compare_images, difference_image};
+use deepbrdf_eval::render::{render, MerlBrdf};
+use std::path::PathBuf;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The reference: a MERL .binary file or a bundled material.
+    pub a: String,
+    /// The material compared with it (e.g. a reconstruction's .binary file).
+    pub b: String,
+    /// Output PNG of |B - A| per pixel in false colour (inferno map).
+    #[arg(short, long, value_name = "PNG")]
+    pub output: PathBuf,
+    /// Error at which the colour map saturates, relative to A's mean pixel value on the object.
+    #[arg(long, default_value_t = 0.5)]
+    pub scale: f64,
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub cache: CacheArg,
+}
+
+pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
+    let scene_config = args.scene.scene()?;
+    let settings = args.scene.settings(256);
+    let tonemap = args.scene.tonemap()?;
+    let cache = args.cache.cache();
+    let (name_a, a) =
+        load_material(&args.a, &cache).with_context(|| format!("loading material '{}'", args.a))?;
+    let (name_b, b) =
+        load_material(&args.b, &cache).with_context(|| format!("loading material '{}'", args.b))?;
+    let scene = scene_config.build()?;
+    // Both rendered with A's sampling proxy and the same seed: the same directions are drawn, so
+    // the difference is the materials', not Monte Carlo noise.
+    let brdf_a = MerlBrdf::new(&a);
+    let image_a = render(&scene, &brdf_a, &settings, progress)?;
+    let image_b = render(&scene, &MerlBrdf::new(&b).with_lobe(brdf_a.lobe()), &settings, progress)?;
+    let c = compare_images(&image_b, &image_a, &tonemap)?;
+    difference_image(&image_b, &image_a, args.scale)?.write_png(&args.output)?;
+    println!(
+        "{name_b} vs {name_a} ({}x{} {} on a {}, {} spp): RelAE {:.4}  RMSE {:.4}  PSNR {:.2} dB -> {}",
+        settings.size,
+        settings.size,
+        scene_config.light,
+        scene_config.shape,
+        settings.spp,
+        c.relae,
+        c.rmse,
+        c.psnr,
+        args.output.display()
+    );
+    Ok(())
+}

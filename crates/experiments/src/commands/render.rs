@@ -1,0 +1,54 @@
+//! `experiments render`: renders one material (a MERL .binary file or a bundled material) to a
+//! tonemapped PNG and, optionally, a linear OpenEXR.
+use crate::data_args::CacheArg;
+use crate::scene_args::SceneArgs;
+use anyhow::Context;
+use deepbrdf_data::dataset::load_material;
+use deepbrdf_data::Progress;
+use deepbrdf_eval::render::{render, MerlBrdf};
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// A MERL .binary file or a bundled material (chrome, merl/chrome, rgl/...).
+    pub material: String,
+    /// Output PNG (tonemapped sRGB).
+    #[arg(short, long, value_name = "PNG")]
+    pub output: PathBuf,
+    /// Also write the linear radiance (and coverage as alpha) as OpenEXR.
+    #[arg(long, value_name = "EXR")]
+    pub exr: Option<PathBuf>,
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub cache: CacheArg,
+}
+
+pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
+    let scene_config = args.scene.scene()?;
+    let settings = args.scene.settings(256);
+    let tonemap = args.scene.tonemap()?;
+    let (name, table) = load_material(&args.material, &args.cache.cache())
+        .with_context(|| format!("loading material '{}'", args.material))?;
+    let scene = scene_config.build()?;
+    let start = Instant::now();
+    let image = render(&scene, &MerlBrdf::new(&table), &settings, progress)?;
+    let seconds = start.elapsed().as_secs_f64();
+    image.write_png(&args.output, &tonemap)?;
+    if let Some(exr) = &args.exr {
+        image.write_exr(exr)?;
+    }
+    println!(
+        "{name}: {}x{} {} on a {}, {} spp, seed {}, rendered in {seconds:.2} s -> {}{}",
+        settings.size,
+        settings.size,
+        scene_config.light,
+        scene_config.shape,
+        settings.spp,
+        settings.seed,
+        args.output.display(),
+        args.exr.as_ref().map(|p| format!(", {}", p.display())).unwrap_or_default()
+    );
+    Ok(())
+}

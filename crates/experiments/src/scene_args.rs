@@ -1,0 +1,74 @@
+//! The scene and rendering arguments shared by `render`, `compare` and `sheet`:
+//! `--shape`, `--light`, `--view`, `--fov`, `--size`, `--spp`, `--seed`, `--exposure`.
+use anyhow::Context;
+use deepbrdf_eval::render::{LightSpec, Projection, RenderSettings, SceneConfig, Shape, Tonemap};
+
+#[derive(Debug, Clone, clap::Args)]
+pub struct SceneArgs {
+    /// Shape: sphere, plane, torus, ellipsoid or cylinder.
+    #[arg(long, default_value = "sphere")]
+    pub shape: String,
+    /// Lighting: sun:ELEV,AZIM[,TURBIDITY] (Preetham sun and sky, degrees), dir:THETA,PHI (a
+    /// directional light, degrees from the zenith and from +x) or const[:L] (constant
+    /// environment).
+    #[arg(long, default_value = "sun:40,30")]
+    pub light: String,
+    /// Viewpoint THETA,PHI in degrees: polar angle from the zenith and azimuth from +x of the
+    /// direction from the object to the camera.
+    #[arg(long, value_name = "THETA,PHI", default_value = "70,0")]
+    pub view: String,
+    /// Perspective camera with this vertical field of view (degrees); orthographic without it.
+    #[arg(long, value_name = "DEG")]
+    pub fov: Option<f64>,
+    /// Image width and height in pixels [default: 256; 128 per tile for `sheet`].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=8192))]
+    pub size: Option<u32>,
+    /// Samples per pixel.
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub spp: u32,
+    /// Seed of the Monte Carlo sampling.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Exposure multiplier applied before tonemapping to 8-bit sRGB.
+    #[arg(long, default_value_t = 1.0)]
+    pub exposure: f32,
+}
+
+impl SceneArgs {
+    /// The scene these arguments describe.
+    pub fn scene(&self) -> anyhow::Result<SceneConfig> {
+        let shape: Shape = self.shape.parse()?;
+        let light: LightSpec = self.light.parse()?;
+        let (theta, phi) = self
+            .view
+            .split_once(',')
+            .and_then(|(a, b)| Some((a.trim().parse::<f64>().ok()?, b.trim().parse::<f64>().ok()?)))
+            .filter(|(a, b)| a.is_finite() && b.is_finite())
+            .with_context(|| format!("--view '{}': expected THETA,PHI in degrees", self.view))?;
+        let projection = match self.fov {
+            Some(fov_deg) => Projection::Perspective { fov_deg },
+            None => Projection::Orthographic,
+        };
+        Ok(SceneConfig { shape, light, view_theta_deg: theta, view_phi_deg: phi, projection })
+    }
+
+    /// Render settings, with `default_size` when `--size` is not given.
+    pub fn settings(&self, default_size: u32) -> RenderSettings {
+        RenderSettings {
+            size: self.size.unwrap_or(default_size),
+            spp: self.spp,
+            seed: self.seed,
+            jitter: true,
+        }
+    }
+
+    /// The tonemapping of PNG output.
+    pub fn tonemap(&self) -> anyhow::Result<Tonemap> {
+        anyhow::ensure!(
+            self.exposure.is_finite() && self.exposure > 0.0,
+            "--exposure {} must be positive",
+            self.exposure
+        );
+        Ok(Tonemap { exposure: self.exposure })
+    }
+}
