@@ -1,5 +1,6 @@
 //! End-to-end tests of the `experiments` command line, compiled as one test binary.
 mod util;
 
+mod baselines;
 mod data;
 mod devices;

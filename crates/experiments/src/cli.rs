@@ -26,4 +26,6 @@ pub enum Command {
     Tabulate(commands::tabulate::Args),
     /// Pack folders of JSON NBRDF networks into the bundled .nbrdf files.
     PackNbrdf(commands::pack_nbrdf::Args),
+    /// Evaluate the PCA and IPCA baselines (§4): summary table, CSV, plots.
+    Baselines(commands::baselines::Args),
 }

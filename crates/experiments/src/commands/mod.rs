@@ -2,6 +2,7 @@
 use crate::cli::{Cli, Command};
 use crate::progress::Bars;
 
+pub mod baselines;
 pub mod bench;
 pub mod devices;
 pub mod info;
@@ -16,5 +17,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Info(args) => info::run(args, &progress),
         Command::Tabulate(args) => tabulate::run(args, &progress),
         Command::PackNbrdf(args) => pack_nbrdf::run(args, &progress),
+        Command::Baselines(args) => baselines::run(args, &progress),
     }
 }
