@@ -2,6 +2,7 @@
 use crate::cli::{Cli, Command};
 use crate::progress::Bars;
 
+pub mod baselines;
 pub mod bench;
 pub mod compare;
 pub mod decode;
@@ -35,5 +36,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Render(args) => render::run(args, &progress),
         Command::Compare(args) => compare::run(args, &progress),
         Command::Sheet(args) => sheet::run(args, &progress),
+        Command::Baselines(args) => baselines::run(args, &progress),
     }
 }

@@ -1,0 +1,218 @@
+//! `experiments baselines`: the PCA and IPCA baselines of §4 (Hu et al. 2020) through the
+//! evaluation harness: fit, encode/decode every material at each k, measure, print the summary
+//! table and write the results folder (CSV, markdown, Fig. 3 / Fig. 7 style plots).
+use crate::data_args::{cache_at, DataArgs};
+use anyhow::{bail, Context};
+use deepbrdf_data::bundled::Collection;
+use deepbrdf_data::dataset::{DataSource, Dataset};
+use deepbrdf_data::Progress;
+use deepbrdf_eval::baseline::BaselineMethod;
+use deepbrdf_eval::harness::{self, HarnessConfig, Materials, Measure, Method, Mode};
+use deepbrdf_eval::ipca::Ipca;
+use deepbrdf_eval::pca::Pca;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Files a results folder receives ([`harness::Results::write`]); an earlier run's copies are
+/// only replaced with `--force`.
+const RESULT_FILES: [&str; 3] = ["results.csv", "fits.csv", "summary.md"];
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Dimensions k of the representation to evaluate (comma-separated).
+    #[arg(long = "k", value_name = "K,...", value_delimiter = ',', default_value = "5,10,20,40")]
+    pub ks: Vec<usize>,
+    /// in-sample (fit on all, evaluate on all: Fig. 3), kfold:N (each material evaluated by a
+    /// basis fitted on the other folds), or generalize (fit on the training collection, evaluate
+    /// on --eval-collections: Fig. 9).
+    #[arg(long, default_value = "in-sample")]
+    pub mode: Mode,
+    /// Results folder [default: results/baselines-<mode>].
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Seed of the k-fold split.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Error measures (comma-separated): mapped_mse (eq. 1 space), cos_rmse.
+    #[arg(long, value_delimiter = ',', default_value = "mapped_mse,cos_rmse")]
+    pub measures: Vec<Measure>,
+    /// Generalize mode: the bundled collections to evaluate on (comma-separated).
+    #[arg(long, value_name = "NAME,...", value_delimiter = ',', default_value = "nielsen2015,rgl")]
+    pub eval_collections: Vec<Collection>,
+    /// Also write the fitted bases (PCA.basis, IPCA.basis, largest k) into DIR
+    /// (in-sample and generalize modes, where one basis is fitted on all training materials).
+    #[arg(long, value_name = "DIR")]
+    pub save_basis: Option<PathBuf>,
+    /// Replace the result (and basis) files of an earlier run; other files are never touched.
+    #[arg(long)]
+    pub force: bool,
+    #[command(flatten)]
+    pub data: DataArgs,
+}
+
+/// The default results folder of a mode: `results/baselines-in-sample`, `-kfold-5`, ...
+pub fn default_out(mode: Mode) -> PathBuf {
+    PathBuf::from("results").join(format!("baselines-{}", mode.to_string().replace(':', "-")))
+}
+
+pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
+    let started = Instant::now();
+    let config = HarnessConfig {
+        ks: args.ks.clone(),
+        mode: args.mode,
+        seed: args.seed,
+        measures: args.measures.clone(),
+    };
+    config.validate()?;
+    if args.save_basis.is_some() && matches!(args.mode, Mode::KFold { .. }) {
+        bail!("--save-basis needs in-sample or generalize mode (k-fold fits one basis per fold)");
+    }
+    if args.mode != Mode::Generalize && args.eval_collections != default_eval_collections() {
+        bail!("--eval-collections is for generalize mode only");
+    }
+    let out = args.out.clone().unwrap_or_else(|| default_out(args.mode));
+    // Refuse before any work, so a long run never ends by refusing to write.
+    check_not_overwriting(&out, &RESULT_FILES, args.force, "results of an earlier run")?;
+    let (pca, ipca) = (Pca::method(), Ipca::method());
+    let (pca, ipca) = match &args.save_basis {
+        Some(dir) => {
+            let names = [format!("{}.basis", pca.name()), format!("{}.basis", ipca.name())];
+            let names: Vec<&str> = names.iter().map(String::as_str).collect();
+            check_not_overwriting(dir, &names, args.force, "a saved basis")?;
+            (pca.keeping_last_fit(), ipca.keeping_last_fit())
+        }
+        None => (pca, ipca),
+    };
+
+    let t = Instant::now();
+    let train = args.data.load(progress)?;
+    eprintln!(
+        "loaded {} ({} materials) in {:.1} s",
+        train.label,
+        train.len(),
+        t.elapsed().as_secs_f64()
+    );
+    let eval = if args.mode == Mode::Generalize {
+        let t = Instant::now();
+        let eval = load_collections(&args.eval_collections, &args.data, progress)?;
+        eprintln!(
+            "loaded {} ({} materials) in {:.1} s",
+            eval.label,
+            eval.len(),
+            t.elapsed().as_secs_f64()
+        );
+        Some(eval)
+    } else {
+        None
+    };
+
+    let train_label = format!("{} ({} materials)", train.label, train.len());
+    let eval_label = eval.as_ref().map(|e| format!("{} ({} materials)", e.label, e.len()));
+    let methods: [&dyn Method; 2] = [&pca, &ipca];
+    let results = harness::run(
+        &methods,
+        &config,
+        Materials { names: &train.names, tables: &train.tables, label: &train_label },
+        eval.as_ref().zip(eval_label.as_deref()).map(|(e, label)| Materials {
+            names: &e.names,
+            tables: &e.tables,
+            label,
+        }),
+        progress,
+    )?;
+    results.write(&out).with_context(|| format!("writing the results to {}", out.display()))?;
+    if let Some(dir) = &args.save_basis {
+        save_bases(dir, &[&pca, &ipca])?;
+    }
+
+    println!(
+        "{} mode: trained on {}, evaluated on {}\n",
+        results.mode, results.train_label, results.eval_label
+    );
+    println!("{}", results.summary_table());
+    let fit_seconds: f64 = results.fits.iter().map(|f| f.seconds).sum();
+    println!(
+        "fits {:.1} s, encoding + decoding + measuring {:.1} s, whole command {:.1} s",
+        fit_seconds,
+        results.eval_seconds,
+        started.elapsed().as_secs_f64()
+    );
+    println!("results written to {}", out.display());
+    Ok(())
+}
+
+fn default_eval_collections() -> Vec<Collection> {
+    vec![Collection::Nielsen2015, Collection::Rgl]
+}
+
+/// Loads bundled `collections` (through the cache of `data`) as one evaluation set. Names are
+/// kept as they are unless two collections share one, which is then prefixed `collection/`.
+fn load_collections(
+    collections: &[Collection],
+    data: &DataArgs,
+    progress: &dyn Progress,
+) -> anyhow::Result<Dataset> {
+    if collections.is_empty() {
+        bail!("generalize mode needs at least one evaluation collection");
+    }
+    let cache = cache_at(data.cache.dir.as_deref());
+    let mut sets = Vec::new();
+    for &c in collections {
+        let set = Dataset::load(&DataSource::Bundled(c), &cache, progress)
+            .with_context(|| format!("loading the evaluation collection {c}"))?;
+        sets.push((c, set));
+    }
+    let mut names: Vec<String> = Vec::new();
+    let mut tables = Vec::new();
+    for (c, set) in &sets {
+        for (name, table) in set.names.iter().zip(&set.tables) {
+            let clash = sets.iter().any(|(o, s)| o != c && s.names.contains(name));
+            names.push(if clash { format!("{c}/{name}") } else { name.clone() });
+            tables.push(table.clone());
+        }
+    }
+    let label = collections.iter().map(|c| c.name()).collect::<Vec<_>>().join(" + ");
+    Ok(Dataset { label, names, tables })
+}
+
+/// Fails when `dir` already holds one of `files`, unless `force`.
+fn check_not_overwriting(
+    dir: &Path,
+    files: &[&str],
+    force: bool,
+    what: &str,
+) -> anyhow::Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        bail!("{} exists and is not a directory", dir.display());
+    }
+    if force {
+        return Ok(());
+    }
+    if let Some(f) = files.iter().find(|f| dir.join(f).exists()) {
+        bail!(
+            "{} already holds {what} ({f}); pass --force to replace those files (nothing else \
+             in the folder is touched) or choose another folder",
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
+/// Writes each method's kept basis to `dir/<name>.basis`.
+fn save_bases(dir: &Path, methods: &[&BaselineMethod]) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    for m in methods {
+        let basis =
+            m.last_fit().with_context(|| format!("{} kept no fitted basis to save", m.name()))?;
+        let path = dir.join(format!("{}.basis", basis.name()));
+        basis.save(&path)?;
+        println!(
+            "saved {} basis ({} components, {} training materials) to {}",
+            basis.name(),
+            basis.basis().k(),
+            basis.n_train(),
+            path.display()
+        );
+    }
+    Ok(())
+}
