@@ -5,3 +5,4 @@ mod data;
 mod devices;
 mod fetch_merl;
 mod render;
+mod sweep_k;

@@ -38,6 +38,32 @@ impl DeviceKind {
         Self::ALL.into_iter().filter(|k| k.is_compiled()).collect()
     }
 
+    /// The default kind: the first compiled in (flex in a default build).
+    pub fn default_kind() -> Option<DeviceKind> {
+        Self::available().into_iter().next()
+    }
+
+    /// The Burn device of this kind, or an error naming the feature to build with.
+    pub fn device(self) -> Result<burn::tensor::Device, String> {
+        #[allow(unused_imports)]
+        use burn::tensor::Device;
+        match self {
+            #[cfg(feature = "flex")]
+            DeviceKind::Flex => Ok(Device::flex()),
+            #[cfg(feature = "ndarray")]
+            #[allow(deprecated)]
+            DeviceKind::Ndarray => Ok(Device::ndarray()),
+            #[cfg(feature = "wgpu")]
+            DeviceKind::Wgpu => Ok(Device::wgpu(Default::default())),
+            #[cfg(feature = "cuda")]
+            DeviceKind::Cuda => Ok(Device::cuda(0)),
+            #[allow(unreachable_patterns)]
+            other => Err(format!(
+                "device '{other}' is not compiled into this binary (rebuild with `--features {other}`)"
+            )),
+        }
+    }
+
     /// The cargo feature (and `--device` name) of this kind.
     pub fn name(self) -> &'static str {
         match self {

@@ -9,6 +9,9 @@ pub struct Cli {
     /// Show no progress bars.
     #[arg(long, short, global = true)]
     pub quiet: bool,
+    /// Compute backend for the networks: flex (default), ndarray, wgpu or cuda, as compiled in.
+    #[arg(long, global = true, value_name = "NAME", value_parser = parse_device)]
+    pub device: Option<deepbrdf_model::DeviceKind>,
     #[command(subcommand)]
     pub command: Command,
 }
@@ -28,6 +31,16 @@ pub enum Command {
     Tabulate(commands::tabulate::Args),
     /// Pack folders of JSON NBRDF networks into the bundled .nbrdf files.
     PackNbrdf(commands::pack_nbrdf::Args),
+    /// Train DeepBRDF (§3.2) on a dataset; resumable.
+    Train(commands::train::Args),
+    /// Print the k latent values of a BRDF under a trained model (eq. 2).
+    Encode(commands::encode::Args),
+    /// Decode a latent vector into a MERL .binary file (eq. 3).
+    Decode(commands::decode::Args),
+    /// Encode and decode a BRDF, optionally from 1/3 or 1/9 of its slices (Fig. 2).
+    Reconstruct(commands::reconstruct::Args),
+    /// The main job: DeepBRDF, PCA and IPCA at each k (Figs. 2, 3 and 7), tables and plots.
+    SweepK(commands::sweep_k::Args),
     /// Render a material (a MERL .binary file or a bundled material) to PNG and EXR.
     Render(commands::render::Args),
     /// Render two materials under the same settings; print RelAE, RMSE and PSNR and write a
@@ -35,4 +48,8 @@ pub enum Command {
     Compare(commands::compare::Args),
     /// Render every material of a dataset on spheres, in one captioned contact sheet.
     Sheet(commands::sheet::Args),
+}
+
+fn parse_device(s: &str) -> Result<deepbrdf_model::DeviceKind, String> {
+    s.parse()
 }

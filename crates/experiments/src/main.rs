@@ -2,8 +2,17 @@
 mod cli;
 mod commands;
 mod data_args;
+mod deep_method;
+mod device_arg;
+mod latent_file;
+mod mapped_input;
+mod nested_baseline;
 mod progress;
+mod progress_log;
+mod readme_block;
+mod robustness;
 mod scene_args;
+mod slices_figure;
 
 use clap::Parser;
 use std::process::ExitCode;

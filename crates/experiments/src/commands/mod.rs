@@ -4,16 +4,22 @@ use crate::progress::Bars;
 
 pub mod bench;
 pub mod compare;
+pub mod decode;
 pub mod devices;
+pub mod encode;
 pub mod fetch_merl;
 pub mod info;
 pub mod pack_nbrdf;
+pub mod reconstruct;
 pub mod render;
 pub mod sheet;
+pub mod sweep_k;
 pub mod tabulate;
+pub mod train;
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     let progress = Bars::new(cli.quiet);
+    crate::device_arg::select(cli.device);
     match cli.command {
         Command::Devices(args) => devices::run(args, &progress),
         Command::Bench(args) => bench::run(args, &progress),
@@ -21,6 +27,11 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Info(args) => info::run(args, &progress),
         Command::Tabulate(args) => tabulate::run(args, &progress),
         Command::PackNbrdf(args) => pack_nbrdf::run(args, &progress),
+        Command::Train(args) => train::run(args, &progress),
+        Command::Encode(args) => encode::run(args, &progress),
+        Command::Decode(args) => decode::run(args, &progress),
+        Command::Reconstruct(args) => reconstruct::run(args, &progress),
+        Command::SweepK(args) => sweep_k::run(args, cli.quiet, &progress),
         Command::Render(args) => render::run(args, &progress),
         Command::Compare(args) => compare::run(args, &progress),
         Command::Sheet(args) => sheet::run(args, &progress),

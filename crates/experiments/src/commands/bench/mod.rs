@@ -4,6 +4,7 @@ use deepbrdf_data::Progress;
 
 pub mod io;
 pub mod lookup;
+pub mod model;
 pub mod render;
 pub mod tabulate;
 
@@ -22,6 +23,9 @@ pub enum What {
     Lookup(lookup::Args),
     /// Tabulating bundled NBRDF networks onto the MERL grid (target: 100 materials < 30 s).
     Tabulate(tabulate::Args),
+    /// DeepBRDF training seconds per BRDF (cpu and paper presets) and decode seconds
+    /// (target: decoding <= 0.15 s on 2 cores).
+    Model(model::Args),
     /// Renderer speed: MERL lookups per second and images per second (target: a 256x256 sphere
     /// of a tabulated MERL material under sun and sky at 64 spp in < 0.5 s on 2 cores).
     Render(render::Args),
@@ -32,6 +36,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         What::Io(a) => io::run(a, progress),
         What::Lookup(a) => lookup::run(a, progress),
         What::Tabulate(a) => tabulate::run(a, progress),
+        What::Model(a) => model::run(a, progress),
         What::Render(a) => render::run(a, progress),
     }
 }

@@ -1,0 +1,435 @@
+//! The self-contained model artifact: a directory holding everything needed to use a trained
+//! DeepBRDF network, with checksums that tie the parts together.
+//!
+//! ```text
+//! model/
+//!   model.json             id, network configuration, training provenance, part checksums
+//!   weights.bpk            the network's parameters (burnpack, Burn's record format)
+//!   median_reference.bin   the eq. (1) reference of the training data (deepbrdf-data format)
+//! ```
+//!
+//! The id is a SHA-256 over the configuration, the provenance and the checksums of both parts,
+//! so editing `model.json` or swapping in the weights or reference of another model is detected
+//! when loading. The directory is written beside its destination and renamed into place.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use burn::prelude::*;
+use burn::store::ModuleRecord;
+use burn::tensor::Bytes;
+use deepbrdf_data::mapping::MedianReference;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+use crate::atomic::{read_limited, sync_parent, write_atomic};
+use crate::autoencoder::{Autoencoder, AutoencoderConfig};
+use crate::error::{ModelError, Result};
+use crate::train::Trained;
+
+/// File name of the manifest.
+pub const MANIFEST_FILE: &str = "model.json";
+/// File name of the weights.
+pub const WEIGHTS_FILE: &str = "weights.bpk";
+/// File name of the median reference.
+pub const REFERENCE_FILE: &str = "median_reference.bin";
+/// Name of the artifact directory that training writes inside its output directory.
+pub const MODEL_DIR: &str = "model";
+const FORMAT: &str = "deepbrdf-model";
+const VERSION: u32 = 1;
+
+/// How a model was trained (§3.2's settings and the data), recorded with the model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Provenance {
+    /// The data source's label (e.g. "merl").
+    pub data_label: String,
+    /// The training BRDFs' names.
+    pub materials: Vec<String>,
+    /// Digest of the training data (see `TrainingSet::fingerprint`).
+    pub data_fingerprint: String,
+    /// The full training configuration (network, optimizer, schedule, seed).
+    pub train_config: serde_json::Value,
+    /// Seed of the run.
+    pub seed: u64,
+    /// Epochs trained.
+    pub epochs: usize,
+    /// The last epoch's mean eq. (4) loss.
+    pub final_loss: f64,
+    /// Mean over the training BRDFs of their mapped-space MSE after training.
+    pub final_mse: f64,
+    /// Seconds of training.
+    pub train_seconds: f64,
+    /// The device it was trained on.
+    pub device: String,
+}
+
+/// Checksum of one part file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct Part {
+    file: String,
+    bytes: u64,
+    sha256: String,
+}
+
+/// The content of `model.json`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Manifest {
+    format: String,
+    version: u32,
+    id: String,
+    config: AutoencoderConfig,
+    provenance: Provenance,
+    weights: Part,
+    reference: Part,
+}
+
+/// A trained model with its median reference and provenance, in memory.
+#[derive(Debug, Clone)]
+pub struct ModelArtifact {
+    config: AutoencoderConfig,
+    provenance: Provenance,
+    weights: Vec<u8>,
+    reference: MedianReference,
+    id: String,
+}
+
+impl ModelArtifact {
+    /// Bundles a trained network with the reference its training data was mapped with.
+    pub fn from_trained(
+        trained: &Trained,
+        reference: MedianReference,
+        data_label: &str,
+        materials: &[String],
+        device: &Device,
+    ) -> Result<Self> {
+        let train_config = serde_json::to_value(&trained.config)
+            .map_err(|e| ModelError::Invalid(format!("cannot serialise the configuration: {e}")))?;
+        let provenance = Provenance {
+            data_label: data_label.to_string(),
+            materials: materials.to_vec(),
+            data_fingerprint: trained.data_fingerprint.clone(),
+            train_config,
+            seed: trained.config.seed,
+            epochs: trained.log.len(),
+            final_loss: trained.final_loss(),
+            final_mse: trained.mean_mse(),
+            train_seconds: trained.seconds,
+            device: format!("{device:?}"),
+        };
+        Self::new(trained.config.model.clone(), provenance, &trained.model, reference)
+    }
+
+    /// Bundles a network, its configuration, reference and provenance.
+    pub fn new(
+        config: AutoencoderConfig,
+        provenance: Provenance,
+        model: &Autoencoder,
+        reference: MedianReference,
+    ) -> Result<Self> {
+        let weights = model
+            .clone()
+            .into_record()
+            .into_bytes()
+            .map_err(|e| ModelError::Invalid(format!("cannot serialise the weights: {e}")))?
+            .to_vec();
+        let mut artifact = Self { config, provenance, weights, reference, id: String::new() };
+        artifact.id = artifact.manifest_id(&artifact.weights_part(), &artifact.reference_part());
+        Ok(artifact)
+    }
+
+    /// The id tying configuration, provenance, weights and reference together.
+    pub fn id(&self) -> &str {
+        &self.id
+    }
+
+    /// The network's configuration.
+    pub fn config(&self) -> &AutoencoderConfig {
+        &self.config
+    }
+
+    /// How the model was trained.
+    pub fn provenance(&self) -> &Provenance {
+        &self.provenance
+    }
+
+    /// The eq. (1) reference the network's inputs are mapped with.
+    pub fn reference(&self) -> &MedianReference {
+        &self.reference
+    }
+
+    /// Builds the network on `device` and loads the weights into it.
+    pub fn model(&self, device: &Device) -> Result<Autoencoder> {
+        let bad = |e: burn::store::RecordError| {
+            ModelError::Invalid(format!("the weights do not fit the configuration: {e}"))
+        };
+        let record =
+            ModuleRecord::from_bytes(Bytes::from_bytes_vec(self.weights.clone())).map_err(bad)?;
+        self.config.init(device)?.try_load_record(record).map_err(bad)
+    }
+
+    /// Writes the artifact directory `dir` (created beside it, then renamed into place).
+    /// An existing `dir` is replaced only if it is itself a model artifact.
+    pub fn save(&self, dir: &Path) -> Result<()> {
+        if dir.exists() && !dir.join(MANIFEST_FILE).is_file() {
+            return Err(ModelError::Invalid(format!(
+                "{} exists and is not a DeepBRDF model; not replacing it",
+                dir.display()
+            )));
+        }
+        let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        let tmp = dir.with_file_name(format!(".{name}.tmp{}", std::process::id()));
+        if tmp.exists() {
+            fs::remove_dir_all(&tmp).map_err(|e| ModelError::io(&tmp, e))?;
+        }
+        fs::create_dir_all(&tmp).map_err(|e| ModelError::io(&tmp, e))?;
+        let result = self.write_parts(&tmp).and_then(|()| replace_dir(&tmp, dir));
+        if result.is_err() {
+            let _ = fs::remove_dir_all(&tmp);
+        }
+        result
+    }
+
+    fn write_parts(&self, dir: &Path) -> Result<()> {
+        write_atomic(&dir.join(WEIGHTS_FILE), &[&self.weights])?;
+        self.reference.save(dir.join(REFERENCE_FILE))?;
+        let manifest = Manifest {
+            format: FORMAT.into(),
+            version: VERSION,
+            id: self.id.clone(),
+            config: self.config.clone(),
+            provenance: self.provenance.clone(),
+            weights: self.weights_part(),
+            reference: self.reference_part(),
+        };
+        let json = serde_json::to_string_pretty(&manifest)
+            .map_err(|e| ModelError::Invalid(format!("cannot serialise the manifest: {e}")))?;
+        write_atomic(&dir.join(MANIFEST_FILE), &[json.as_bytes(), b"\n"])
+    }
+
+    /// Loads an artifact directory, or a training output directory holding one in `model/`,
+    /// checking that configuration, provenance, weights and reference belong together.
+    pub fn load(path: &Path) -> Result<Self> {
+        let dir = resolve_dir(path)?;
+        let manifest_path = dir.join(MANIFEST_FILE);
+        let text = read_limited(&manifest_path, 64 << 20)?;
+        let manifest: Manifest = serde_json::from_slice(&text).map_err(|e| {
+            ModelError::format(&manifest_path, format!("not a DeepBRDF model manifest: {e}"))
+        })?;
+        if manifest.format != FORMAT || manifest.version != VERSION {
+            return Err(ModelError::format(
+                &manifest_path,
+                format!(
+                    "format {} version {}, expected {FORMAT} version {VERSION}",
+                    manifest.format, manifest.version
+                ),
+            ));
+        }
+        manifest.config.validate()?;
+        let weights_path = dir.join(WEIGHTS_FILE);
+        let weights = read_limited(&weights_path, 4 << 30)?;
+        if part_of(&weights, WEIGHTS_FILE) != manifest.weights {
+            return Err(ModelError::mismatch(
+                &weights_path,
+                format!("these weights do not belong to model {} (checksum differs)", manifest.id),
+            ));
+        }
+        let reference_path = dir.join(REFERENCE_FILE);
+        let reference = MedianReference::load(&reference_path)?;
+        let artifact = Self {
+            config: manifest.config,
+            provenance: manifest.provenance,
+            weights,
+            reference,
+            id: manifest.id,
+        };
+        if artifact.reference_part() != manifest.reference {
+            return Err(ModelError::mismatch(
+                &reference_path,
+                format!(
+                    "this median reference does not belong to model {} (checksum differs)",
+                    artifact.id
+                ),
+            ));
+        }
+        let expected = artifact.manifest_id(&manifest.weights, &manifest.reference);
+        if expected != artifact.id {
+            return Err(ModelError::mismatch(
+                &manifest_path,
+                "the manifest was edited or damaged (its id does not match its content)",
+            ));
+        }
+        Ok(artifact)
+    }
+
+    fn weights_part(&self) -> Part {
+        part_of(&self.weights, WEIGHTS_FILE)
+    }
+
+    /// The reference's checksum is taken over its values (little-endian f32), not over the
+    /// file, whose own format and checksum belong to `deepbrdf-data`.
+    fn reference_part(&self) -> Part {
+        let mut hasher = Sha256::new();
+        for v in self.reference.values() {
+            hasher.update(v.to_le_bytes());
+        }
+        Part {
+            file: REFERENCE_FILE.into(),
+            bytes: 4 * self.reference.values().len() as u64,
+            sha256: hex::encode(hasher.finalize()),
+        }
+    }
+
+    fn manifest_id(&self, weights: &Part, reference: &Part) -> String {
+        let content = serde_json::json!({
+            "config": self.config,
+            "provenance": self.provenance,
+            "weights": weights,
+            "reference": reference,
+        });
+        let digest = Sha256::digest(content.to_string().as_bytes());
+        hex::encode(&digest[..16])
+    }
+}
+
+fn part_of(bytes: &[u8], file: &str) -> Part {
+    Part {
+        file: file.into(),
+        bytes: bytes.len() as u64,
+        sha256: hex::encode(Sha256::digest(bytes)),
+    }
+}
+
+/// `path` itself if it holds a manifest, else `path/model` if that does.
+pub fn resolve_dir(path: &Path) -> Result<PathBuf> {
+    if path.join(MANIFEST_FILE).is_file() {
+        return Ok(path.to_path_buf());
+    }
+    let inner = path.join(MODEL_DIR);
+    if inner.join(MANIFEST_FILE).is_file() {
+        return Ok(inner);
+    }
+    if !path.exists() {
+        return Err(ModelError::io(path, std::io::Error::from(std::io::ErrorKind::NotFound)));
+    }
+    Err(ModelError::format(
+        path,
+        format!("not a DeepBRDF model (no {MANIFEST_FILE} here or in {MODEL_DIR}/)"),
+    ))
+}
+
+/// Moves the finished directory `tmp` to `dir`, replacing an older artifact there.
+fn replace_dir(tmp: &Path, dir: &Path) -> Result<()> {
+    if dir.exists() {
+        let old = tmp.with_extension("old");
+        if old.exists() {
+            fs::remove_dir_all(&old).map_err(|e| ModelError::io(&old, e))?;
+        }
+        fs::rename(dir, &old).map_err(|e| ModelError::io(dir, e))?;
+        fs::rename(tmp, dir).map_err(|e| ModelError::io(dir, e))?;
+        fs::remove_dir_all(&old).map_err(|e| ModelError::io(&old, e))?;
+    } else {
+        fs::rename(tmp, dir).map_err(|e| ModelError::io(dir, e))?;
+    }
+    sync_parent(dir);
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::device::DeviceKind;
+    use deepbrdf_data::merl::VALUES;
+
+    fn tiny() -> AutoencoderConfig {
+        AutoencoderConfig::new()
+            .with_latent(2)
+            .with_projection(Some(1))
+            .with_encoder_channels([1, 1, 1])
+            .with_residual_blocks(1)
+            .with_decoder_channels([1, 1])
+            .with_mean_offset(true)
+    }
+
+    fn provenance() -> Provenance {
+        Provenance {
+            data_label: "synthetic".into(),
+            materials: vec!["a".into(), "b".into()],
+            data_fingerprint: "00".into(),
+            train_config: serde_json::json!({"seed": 1}),
+            seed: 1,
+            epochs: 3,
+            final_loss: 0.5,
+            final_mse: 0.25,
+            train_seconds: 1.0,
+            device: "test".into(),
+        }
+    }
+
+    fn copy_dir(from: &Path, to: &Path) {
+        fs::create_dir_all(to).unwrap();
+        for entry in fs::read_dir(from).unwrap() {
+            let entry = entry.unwrap();
+            fs::copy(entry.path(), to.join(entry.file_name())).unwrap();
+        }
+    }
+
+    #[test]
+    fn saved_artifacts_load_and_mismatched_parts_are_detected() {
+        let device = DeviceKind::default_kind().unwrap().device().unwrap();
+        device.seed(1);
+        let model_a = tiny().init(&device).unwrap();
+        let model_b = tiny().init(&device).unwrap();
+        let ref_a = MedianReference::from_values(vec![0.25; VALUES]).unwrap();
+        let ref_b = MedianReference::from_values(vec![0.5; VALUES]).unwrap();
+        let a = ModelArtifact::new(tiny(), provenance(), &model_a, ref_a).unwrap();
+        let b = ModelArtifact::new(tiny(), provenance(), &model_b, ref_b).unwrap();
+        assert_ne!(a.id(), b.id());
+
+        let root = tempfile::tempdir().unwrap();
+        let (dir_a, dir_b) = (root.path().join("run").join(MODEL_DIR), root.path().join("b"));
+        fs::create_dir_all(root.path().join("run")).unwrap();
+        a.save(&dir_a).unwrap();
+        a.save(&dir_a).unwrap(); // replacing an artifact is allowed
+        b.save(&dir_b).unwrap();
+        let back = ModelArtifact::load(&dir_a).unwrap();
+        assert_eq!(back.id(), a.id());
+        assert_eq!(back.provenance(), &provenance());
+        // A training directory resolves to its model/.
+        assert_eq!(ModelArtifact::load(&root.path().join("run")).unwrap().id(), a.id());
+        // The loaded weights are the saved ones.
+        let z = Tensor::<2>::from_floats([[0.3, -0.7]], &device);
+        let expected: Vec<f32> = model_a.decode(z.clone()).into_data().try_into_vec().unwrap();
+        let got: Vec<f32> =
+            back.model(&device).unwrap().decode(z).into_data().try_into_vec().unwrap();
+        assert_eq!(expected, got);
+
+        for (file, what) in [(WEIGHTS_FILE, "weights"), (REFERENCE_FILE, "median reference")] {
+            let mixed = root.path().join(format!("mixed-{what}"));
+            copy_dir(&dir_a, &mixed);
+            fs::copy(dir_b.join(file), mixed.join(file)).unwrap();
+            let err = ModelArtifact::load(&mixed).unwrap_err().to_string();
+            assert!(err.contains(file) && err.contains("not belong"), "{err}");
+        }
+        let edited = root.path().join("edited");
+        copy_dir(&dir_a, &edited);
+        let text = fs::read_to_string(edited.join(MANIFEST_FILE)).unwrap();
+        fs::write(
+            edited.join(MANIFEST_FILE),
+            text.replace("\"final_mse\": 0.25", "\"final_mse\": 0.01"),
+        )
+        .unwrap();
+        let err = ModelArtifact::load(&edited).unwrap_err().to_string();
+        assert!(err.contains("edited"), "{err}");
+        fs::write(edited.join(MANIFEST_FILE), "{ not json").unwrap();
+        assert!(ModelArtifact::load(&edited).unwrap_err().to_string().contains("model.json"));
+
+        // Never replaces a directory that is not a model, nor loads from one.
+        let user = root.path().join("user");
+        fs::create_dir_all(&user).unwrap();
+        fs::write(user.join("notes.txt"), "mine").unwrap();
+        assert!(a.save(&user).is_err());
+        assert_eq!(fs::read_to_string(user.join("notes.txt")).unwrap(), "mine");
+        assert!(ModelArtifact::load(&user).is_err());
+        assert!(ModelArtifact::load(&root.path().join("missing")).is_err());
+    }
+}

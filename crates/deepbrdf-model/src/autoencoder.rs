@@ -1,0 +1,363 @@
+//! The DeepBRDF autoencoder (Hu et al., CGF 2020, §3.2, Table 1) and its CPU-sized variant.
+//!
+//! The input is one BRDF in the §3.2 layout: 540 channels (phi_d x rgb) of 90 x 90 images
+//! (rows theta_h, columns theta_d), values in the eq. (1) mapped space. Invalid cells are zeroed
+//! at the input (§3.2, footnote †), so the encoder takes the validity mask with the values.
+//!
+//! [`AutoencoderConfig::paper`] is Table 1 exactly: three 3x3 stride-2 convolutions
+//! (540 -> 256 -> 128 -> 64 channels, 90 -> 45 -> 23 -> 12 pixels), three residual blocks at
+//! 64 x 12 x 12, FC to k, FC back to 64 x 12 x 12 and three deconvolutions to 128 x 24 x 24,
+//! 256 x 48 x 48 and 540 x 90 x 90 (the last 4x4), with the paddings of the PyTorch reference
+//! (`shared/bench/torch_table1.py`).
+//!
+//! [`AutoencoderConfig::cpu`] keeps that shape but works on a per-pixel projection of the 540
+//! slice channels: a 1x1 convolution 540 -> C at 90 x 90 first and C -> 540 last, with narrow
+//! layers in between, and predicts deviations from the per-value training mean (a fixed,
+//! non-trained offset). See the README for why and what it costs.
+
+use burn::module::Param;
+use burn::nn::conv::{Conv2d, Conv2dConfig, ConvTranspose2d, ConvTranspose2dConfig};
+use burn::nn::{Linear, LinearConfig, PaddingConfig2d};
+use burn::prelude::*;
+use burn::tensor::activation::leaky_relu;
+use burn::tensor::TensorData;
+
+use crate::error::ModelError;
+
+/// Channels of the §3.2 layout: 180 phi_d slices x 3 colour channels.
+pub const INPUT_CHANNELS: usize = 540;
+/// Side of each layout image (90 theta_h rows x 90 theta_d columns).
+pub const INPUT_SIDE: usize = 90;
+/// Values of one BRDF in the layout (`540 * 90 * 90`, the MERL table's value count).
+pub const INPUT_VALUES: usize = INPUT_CHANNELS * INPUT_SIDE * INPUT_SIDE;
+/// Side of the bottleneck images after three stride-2 convolutions (90 -> 45 -> 23 -> 12).
+pub const BOTTLENECK_SIDE: usize = 12;
+
+/// Architecture of the autoencoder. `k` ([`latent`](Self::latent)) is the FC-10 of Table 1.
+#[derive(Config, Debug, PartialEq)]
+pub struct AutoencoderConfig {
+    /// k, the dimension of the latent vector (Table 1's FC-10; §3.2 studies 5 to 40).
+    #[config(default = 10)]
+    pub latent: usize,
+    /// Width C of a per-pixel 1x1 projection 540 -> C applied first (and C -> 540 applied
+    /// last); `None` in Table 1, where the strided convolutions see all 540 channels.
+    #[config(default = "None")]
+    pub projection: Option<usize>,
+    /// Output channels of the three 3x3 stride-2 convolutions (Table 1: 256, 128, 64).
+    #[config(default = "[256, 128, 64]")]
+    pub encoder_channels: [usize; 3],
+    /// Number of residual blocks at the bottleneck (Table 1: 3).
+    #[config(default = 3)]
+    pub residual_blocks: usize,
+    /// Output channels of the first two deconvolutions (Table 1: 128 at 24 x 24, 256 at 48 x 48).
+    #[config(default = "[128, 256]")]
+    pub decoder_channels: [usize; 2],
+    /// Negative slope of the leaky ReLUs (PyTorch's default, as the paper does not say).
+    #[config(default = 0.01)]
+    pub negative_slope: f64,
+    /// Predict deviations from a fixed per-value offset (the training mean in mapped space,
+    /// set with [`Autoencoder::with_offset`]); the input is centred on it too. Not in Table 1.
+    #[config(default = false)]
+    pub mean_offset: bool,
+}
+
+impl AutoencoderConfig {
+    /// Table 1 exactly, with latent dimension `k`.
+    pub fn paper(k: usize) -> Self {
+        Self::new().with_latent(k)
+    }
+
+    /// The CPU preset: a 1x1 projection to 24 channels at 90 x 90, narrow strided convolutions
+    /// and residual blocks, and an output centred on the training mean. Sized so that the
+    /// default `sweep-k` trains four models on 100 materials within its 30-minute budget on a
+    /// 2-core CPU.
+    pub fn cpu(k: usize) -> Self {
+        Self::new()
+            .with_latent(k)
+            .with_projection(Some(24))
+            .with_encoder_channels([32, 48, 64])
+            .with_residual_blocks(2)
+            .with_decoder_channels([48, 32])
+            .with_mean_offset(true)
+    }
+
+    /// Checks the sizes once, so [`init`](Self::init) cannot build a degenerate network.
+    pub fn validate(&self) -> crate::error::Result<()> {
+        let widths = self
+            .encoder_channels
+            .iter()
+            .chain(self.decoder_channels.iter())
+            .chain(self.projection.iter());
+        if self.latent == 0 || self.latent > 4096 {
+            return Err(ModelError::Invalid(format!(
+                "latent dimension k = {} is out of range (1 to 4096)",
+                self.latent
+            )));
+        }
+        if let Some(w) = widths.into_iter().find(|&&w| w == 0 || w > 4096) {
+            return Err(ModelError::Invalid(format!("a layer width of {w} is out of range")));
+        }
+        if self.residual_blocks > 64 {
+            return Err(ModelError::Invalid(format!(
+                "{} residual blocks is out of range (0 to 64)",
+                self.residual_blocks
+            )));
+        }
+        if !self.negative_slope.is_finite() {
+            return Err(ModelError::Invalid("the leaky ReLU slope must be finite".into()));
+        }
+        Ok(())
+    }
+
+    /// Builds the network on `device` with freshly initialised weights (and a zero offset).
+    pub fn init(&self, device: &Device) -> crate::error::Result<Autoencoder> {
+        self.validate()?;
+        let [e0, e1, e2] = self.encoder_channels;
+        let [d0, d1] = self.decoder_channels;
+        let first = self.projection.unwrap_or(INPUT_CHANNELS);
+        let down = |c_in: usize, c_out: usize| {
+            Conv2dConfig::new([c_in, c_out], [3, 3])
+                .with_stride([2, 2])
+                .with_padding(PaddingConfig2d::Explicit(1, 1, 1, 1))
+                .init(device)
+        };
+        // PyTorch ConvTranspose2d(c_in, c_out, 3, 2, 1, output_padding = 1): n -> 2n.
+        let up = |c_in: usize, c_out: usize| {
+            ConvTranspose2dConfig::new([c_in, c_out], [3, 3])
+                .with_stride([2, 2])
+                .with_padding([1, 1])
+                .with_padding_out([1, 1])
+                .init(device)
+        };
+        let bottleneck = e2 * BOTTLENECK_SIDE * BOTTLENECK_SIDE;
+        Ok(Autoencoder {
+            project_in: self
+                .projection
+                .map(|c| Conv2dConfig::new([INPUT_CHANNELS, c], [1, 1]).init(device)),
+            down: vec![down(first, e0), down(e0, e1), down(e1, e2)],
+            residual: (0..self.residual_blocks).map(|_| ResidualBlock::new(e2, device)).collect(),
+            to_latent: LinearConfig::new(bottleneck, self.latent).init(device),
+            from_latent: LinearConfig::new(self.latent, bottleneck).init(device),
+            // PyTorch ConvTranspose2d(c_in, c_out, 4, 2, 4): 48 -> (48 - 1) * 2 - 8 + 4 = 90.
+            up: vec![
+                up(e2, d0),
+                up(d0, d1),
+                ConvTranspose2dConfig::new([d1, first], [4, 4])
+                    .with_stride([2, 2])
+                    .with_padding([4, 4])
+                    .init(device),
+            ],
+            project_out: self
+                .projection
+                .map(|c| Conv2dConfig::new([c, INPUT_CHANNELS], [1, 1]).init(device)),
+            offset: self.mean_offset.then(|| {
+                Param::from_tensor(Tensor::zeros([INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE], device))
+                    .set_require_grad(false)
+            }),
+            bottleneck_channels: e2,
+            latent: self.latent,
+            negative_slope: self.negative_slope,
+        })
+    }
+}
+
+/// A residual block of §3.2 ([HZRS16]): two 3x3 convolutions, a leaky ReLU and a skip.
+#[derive(Module, Debug)]
+pub struct ResidualBlock {
+    conv1: Conv2d,
+    conv2: Conv2d,
+}
+
+impl ResidualBlock {
+    fn new(channels: usize, device: &Device) -> Self {
+        let conv = || {
+            Conv2dConfig::new([channels, channels], [3, 3])
+                .with_padding(PaddingConfig2d::Explicit(1, 1, 1, 1))
+                .init(device)
+        };
+        Self { conv1: conv(), conv2: conv() }
+    }
+
+    /// `act(x + conv2(act(conv1(x))))`.
+    ///
+    /// # Shapes
+    /// - x: `[batch, c, 12, 12]` -> `[batch, c, 12, 12]`
+    fn forward(&self, x: Tensor<4>, slope: f64) -> Tensor<4> {
+        let y = leaky_relu(self.conv1.forward(x.clone()), slope); // [batch, c, 12, 12]
+        leaky_relu(x + self.conv2.forward(y), slope) // [batch, c, 12, 12]
+    }
+}
+
+/// The autoencoder of §3.2: encoder f (eq. 2) and decoder g (eq. 3).
+#[derive(Module, Debug)]
+pub struct Autoencoder {
+    project_in: Option<Conv2d>,
+    down: Vec<Conv2d>,
+    residual: Vec<ResidualBlock>,
+    to_latent: Linear,
+    from_latent: Linear,
+    up: Vec<ConvTranspose2d>,
+    project_out: Option<Conv2d>,
+    /// Fixed per-value offset (the training mean in mapped space), not trained.
+    offset: Option<Param<Tensor<3>>>,
+    bottleneck_channels: usize,
+    latent: usize,
+    negative_slope: f64,
+}
+
+impl Autoencoder {
+    /// Sets the fixed output offset (the per-value training mean, 540 x 90 x 90 in layout order).
+    /// Errors if the configuration has no offset or `values` has the wrong length.
+    pub fn with_offset(mut self, values: &[f32]) -> crate::error::Result<Self> {
+        let Some(param) = self.offset.take() else {
+            return Err(ModelError::Invalid("this configuration has no mean offset".into()));
+        };
+        if values.len() != INPUT_VALUES {
+            return Err(ModelError::Invalid(format!(
+                "an offset has {INPUT_VALUES} values, got {}",
+                values.len()
+            )));
+        }
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(ModelError::Invalid(format!("offset value {i} is not finite")));
+        }
+        let data = TensorData::new(values.to_vec(), [INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE]);
+        let param = param.map(|old| Tensor::from_data(data, &old.device()));
+        self.offset = Some(param.set_require_grad(false));
+        Ok(self)
+    }
+
+    /// The latent dimension k.
+    pub fn latent(&self) -> usize {
+        self.latent
+    }
+
+    /// Encoder f (eq. 2): the k latent values of each BRDF. Invalid cells are zeroed first.
+    ///
+    /// # Shapes
+    /// - input: `[batch, 540, 90, 90]` mapped values
+    /// - mask: `[batch, 540, 90, 90]`, 1 for valid cells, 0 for invalid ones
+    /// - output: `[batch, k]`
+    pub fn encode(&self, input: Tensor<4>, mask: Tensor<4>) -> Tensor<2> {
+        let slope = self.negative_slope;
+        let batch = input.dims()[0];
+        let x = match &self.offset {
+            Some(offset) => (input - offset.val().unsqueeze_dim::<4>(0)) * mask, // [batch, 540, 90, 90]
+            None => input * mask, // [batch, 540, 90, 90]
+        };
+        let mut x = match &self.project_in {
+            Some(conv) => leaky_relu(conv.forward(x), slope), // [batch, C, 90, 90]
+            None => x,
+        };
+        for conv in &self.down {
+            x = leaky_relu(conv.forward(x), slope); // [batch, e0, 45, 45], [batch, e1, 23, 23], [batch, e2, 12, 12]
+        }
+        for block in &self.residual {
+            x = block.forward(x, slope); // [batch, e2, 12, 12]
+        }
+        let x = x.reshape([batch, self.bottleneck_channels * BOTTLENECK_SIDE * BOTTLENECK_SIDE]); // [batch, e2*144]
+        self.to_latent.forward(x) // [batch, k]
+    }
+
+    /// Decoder g (eq. 3): the mapped BRDF of each latent vector.
+    ///
+    /// # Shapes
+    /// - latent: `[batch, k]`
+    /// - output: `[batch, 540, 90, 90]` mapped values (invalid cells are meaningless)
+    pub fn decode(&self, latent: Tensor<2>) -> Tensor<4> {
+        let slope = self.negative_slope;
+        let batch = latent.dims()[0];
+        let y = leaky_relu(self.from_latent.forward(latent), slope); // [batch, e2*144]
+        let mut y = y.reshape([batch, self.bottleneck_channels, BOTTLENECK_SIDE, BOTTLENECK_SIDE]); // [batch, e2, 12, 12]
+        let last = self.up.len().saturating_sub(1);
+        for (i, deconv) in self.up.iter().enumerate() {
+            y = deconv.forward(y); // [batch, d0, 24, 24], [batch, d1, 48, 48], [batch, C or 540, 90, 90]
+            if i < last {
+                y = leaky_relu(y, slope);
+            }
+        }
+        let y = match &self.project_out {
+            Some(conv) => conv.forward(leaky_relu(y, slope)), // [batch, 540, 90, 90]
+            None => y,
+        };
+        match &self.offset {
+            Some(offset) => y + offset.val().unsqueeze_dim::<4>(0), // [batch, 540, 90, 90]
+            None => y,
+        }
+    }
+
+    /// g(f(x)): the reconstruction the loss of eq. (4) compares with the input.
+    ///
+    /// # Shapes
+    /// - input, mask: `[batch, 540, 90, 90]`
+    /// - output: `[batch, 540, 90, 90]`
+    pub fn forward(&self, input: Tensor<4>, mask: Tensor<4>) -> Tensor<4> {
+        let latent = self.encode(input, mask); // [batch, k]
+        self.decode(latent) // [batch, 540, 90, 90]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn device() -> Device {
+        Device::default()
+    }
+
+    #[test]
+    fn presets_validate_and_differ_only_where_documented() {
+        let paper = AutoencoderConfig::paper(10);
+        assert_eq!(paper.encoder_channels, [256, 128, 64]);
+        assert_eq!(paper.decoder_channels, [128, 256]);
+        assert_eq!(paper.residual_blocks, 3);
+        assert_eq!(paper.projection, None);
+        assert!(!paper.mean_offset);
+        paper.validate().unwrap();
+        AutoencoderConfig::cpu(40).validate().unwrap();
+        assert!(AutoencoderConfig::paper(0).validate().is_err());
+        assert!(AutoencoderConfig::cpu(10).with_projection(Some(0)).validate().is_err());
+    }
+
+    #[test]
+    fn shapes_follow_table_1_with_a_narrow_network() {
+        // Same strides, kernels and paddings as Table 1, narrow widths to stay fast.
+        let config = AutoencoderConfig::new()
+            .with_latent(3)
+            .with_projection(Some(2))
+            .with_encoder_channels([2, 2, 2])
+            .with_residual_blocks(1)
+            .with_decoder_channels([2, 2])
+            .with_mean_offset(true);
+        let model = config.init(&device()).unwrap();
+        assert_eq!(model.latent(), 3);
+        let x = Tensor::<4>::ones([1, INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE], &device());
+        let z = model.encode(x.clone(), x.clone());
+        assert_eq!(z.dims(), [1, 3]);
+        let y = model.decode(z);
+        assert_eq!(y.dims(), [1, INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE]);
+    }
+
+    #[test]
+    fn offset_is_added_to_the_output_and_rejected_when_absent() {
+        let config = AutoencoderConfig::new()
+            .with_latent(2)
+            .with_projection(Some(1))
+            .with_encoder_channels([1, 1, 1])
+            .with_residual_blocks(0)
+            .with_decoder_channels([1, 1])
+            .with_mean_offset(true);
+        let model = config.init(&device()).unwrap();
+        let z = Tensor::<2>::zeros([1, 2], &device());
+        let base: Vec<f32> = model.decode(z.clone()).into_data().try_into_vec().unwrap();
+        let offset: Vec<f32> = (0..INPUT_VALUES).map(|i| (i % 7) as f32).collect();
+        let model = model.with_offset(&offset).unwrap();
+        let shifted: Vec<f32> = model.decode(z).into_data().try_into_vec().unwrap();
+        for i in [0, 1, 5, 12345, INPUT_VALUES - 1] {
+            assert!((shifted[i] - base[i] - offset[i]).abs() < 1e-5, "value {i}");
+        }
+        assert!(model.with_offset(&[0.0; 3]).is_err());
+        let plain = config.with_mean_offset(false).init(&device()).unwrap();
+        assert!(plain.with_offset(&offset).is_err());
+    }
+}

@@ -1,0 +1,40 @@
+//! The whole DeepBRDF pipeline on a set of measured BRDFs: the eq. (1) median reference of the
+//! training tables, the mapped §3.2 layouts, training (§3.2) and the saved model artifact.
+
+use std::path::Path;
+
+use burn::prelude::*;
+use deepbrdf_data::mapping::MedianReference;
+use deepbrdf_data::{MerlTable, Progress};
+
+use crate::artifact::{ModelArtifact, MODEL_DIR};
+use crate::codec::DeepBrdf;
+use crate::error::Result;
+use crate::train::{train, TrainConfig};
+use crate::training_set::TrainingSet;
+
+/// Trains DeepBRDF on `tables` (named `names`, from the data source `label`), keeping the
+/// checkpoint and log in `out_dir` and writing the model artifact to `out_dir/model`.
+///
+/// With `resume`, an interrupted run in `out_dir` is continued (a finished one is only
+/// re-evaluated and re-saved); without it, an existing run there is an error.
+#[allow(clippy::too_many_arguments)]
+pub fn fit(
+    config: &TrainConfig,
+    label: &str,
+    names: &[String],
+    tables: &[&MerlTable],
+    out_dir: &Path,
+    resume: bool,
+    progress: &dyn Progress,
+    device: &Device,
+) -> Result<DeepBrdf> {
+    config.validate()?;
+    let reference = MedianReference::from_tables(tables)?;
+    let set = TrainingSet::from_tables(label, names, tables, &reference)?;
+    let trained = train(config, &set, out_dir, resume, progress, device)?;
+    drop(set);
+    let artifact = ModelArtifact::from_trained(&trained, reference, label, names, device)?;
+    artifact.save(&out_dir.join(MODEL_DIR))?;
+    DeepBrdf::from_artifact(artifact, device)
+}

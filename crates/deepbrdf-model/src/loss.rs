@@ -1,0 +1,51 @@
+//! The reconstruction loss of eq. (4) with the L2 norm (§3.2 "Loss Function"): only valid cells
+//! count, through the *mask* function, and the squared error is averaged over them.
+//!
+//! Eq. (4) sums `||mask(g(f(X))) - mask(X)||` over the training set; we use the mean over valid
+//! values of the squared difference, which has the same minimiser, keeps the learning rate
+//! independent of the batch size, and equals the mapped-space MSE the evaluation reports.
+
+use burn::prelude::*;
+
+/// Mean squared error over the cells where `mask` is 1 (eq. 4, L2).
+///
+/// # Shapes
+/// - prediction, target, mask: `[batch, 540, 90, 90]` (any equal shape)
+/// - output: `[1]`
+pub fn masked_mse<const D: usize>(
+    prediction: Tensor<D>,
+    target: Tensor<D>,
+    mask: Tensor<D>,
+) -> Tensor<1> {
+    let valid = mask.clone().sum().clamp_min(1.0); // [1]
+    let diff = (prediction - target) * mask; // [batch, 540, 90, 90]
+    (diff.clone() * diff).sum() / valid // [1]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn invalid_cells_do_not_count() {
+        let device = Device::default();
+        // Two valid cells with errors 1 and 3 -> (1 + 9) / 2 = 5; the invalid cell's error of
+        // 100 is ignored, whatever its value.
+        let prediction = Tensor::<1>::from_floats([1.0, 3.0, 100.0], &device);
+        let target = Tensor::<1>::from_floats([0.0, 0.0, 0.0], &device);
+        let mask = Tensor::<1>::from_floats([1.0, 1.0, 0.0], &device);
+        let loss: f32 = masked_mse(prediction, target.clone(), mask.clone()).into_scalar();
+        assert!((loss - 5.0).abs() < 1e-6, "{loss}");
+        let prediction = Tensor::<1>::from_floats([1.0, 3.0, -7.0e6], &device);
+        let loss: f32 = masked_mse(prediction, target, mask).into_scalar();
+        assert!((loss - 5.0).abs() < 1e-6, "{loss}");
+    }
+
+    #[test]
+    fn an_all_invalid_batch_has_zero_loss() {
+        let device = Device::default();
+        let x = Tensor::<2>::ones([2, 3], &device);
+        let loss: f32 = masked_mse(x.clone(), x.zeros_like(), x.zeros_like()).into_scalar();
+        assert_eq!(loss, 0.0);
+    }
+}

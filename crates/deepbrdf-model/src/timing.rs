@@ -1,0 +1,111 @@
+//! Speed measurements of the networks, for `experiments bench model`: seconds per training step
+//! (forward, eq. (4) loss, backward, Adam) and seconds to decode a latent vector into a full
+//! MERL table. Inputs are synthetic (random mapped values on the MERL grid's mask): speed does
+//! not depend on the values.
+
+use std::time::Instant;
+
+use burn::optim::{AdamConfig, GradientsParams};
+use burn::prelude::*;
+use burn::tensor::{Distribution, TensorData};
+use deepbrdf_data::layout::{from_layout, mask_layout};
+use deepbrdf_data::mapping::MedianReference;
+use deepbrdf_data::merl::VALUES;
+
+use crate::autoencoder::{AutoencoderConfig, INPUT_CHANNELS, INPUT_SIDE};
+use crate::codec::grid_mask;
+use crate::error::{ModelError, Result};
+use crate::loss::masked_mse;
+
+/// Median and all timings of repeated runs, in seconds.
+#[derive(Debug, Clone)]
+pub struct Timing {
+    /// Every measured run (the warm-up excluded).
+    pub runs: Vec<f64>,
+}
+
+impl Timing {
+    /// The median run.
+    pub fn median(&self) -> f64 {
+        let mut v = self.runs.clone();
+        v.sort_by(f64::total_cmp);
+        if v.is_empty() {
+            return f64::NAN;
+        }
+        v[v.len() / 2]
+    }
+}
+
+/// Times `steps` training steps (after one warm-up step) on batches of `batch` BRDFs.
+pub fn training_steps(
+    config: &AutoencoderConfig,
+    batch: usize,
+    steps: usize,
+    device: &Device,
+) -> Result<Timing> {
+    if batch == 0 || steps == 0 {
+        return Err(ModelError::Invalid("need at least one step of one BRDF".into()));
+    }
+    let device = device.clone().autodiff();
+    device.seed(0);
+    let mut model = config.init(&device)?;
+    let mut optim = AdamConfig::new().init();
+    let shape = [batch, INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE];
+    let mask_one = mask_layout(&grid_mask());
+    let mask: Vec<f32> = (0..batch).flat_map(|_| mask_one.iter().copied()).collect();
+    let mask = Tensor::<4>::from_data(TensorData::new(mask, shape), &device);
+    let input = Tensor::<4>::random(shape, Distribution::Uniform(0.0, 2.0), &device) * mask.clone();
+    let mut runs = Vec::with_capacity(steps);
+    for step in 0..=steps {
+        let start = Instant::now();
+        let output = model.forward(input.clone(), mask.clone());
+        let loss = masked_mse(output, input.clone(), mask.clone());
+        let value: f32 = loss.clone().into_scalar();
+        let grads = GradientsParams::from_grads(loss.backward(), &model);
+        model = optim.step(1e-5, model, grads);
+        device.sync().map_err(|e| ModelError::Invalid(format!("device error: {e:?}")))?;
+        if !value.is_finite() {
+            return Err(ModelError::Invalid("the benchmark's loss is not finite".into()));
+        }
+        if step > 0 {
+            runs.push(start.elapsed().as_secs_f64());
+        }
+    }
+    Ok(Timing { runs })
+}
+
+/// Times decoding one latent vector into a full MERL table (network, inverse layout, inverse
+/// eq. (1) on the grid's valid cells): `(network only, whole decode)` over `repeats` runs
+/// after one warm-up.
+pub fn decode(
+    config: &AutoencoderConfig,
+    repeats: usize,
+    device: &Device,
+) -> Result<(Timing, Timing)> {
+    let device = device.clone().without_autodiff();
+    device.seed(0);
+    let model = config.init(&device)?;
+    let reference = MedianReference::from_values(vec![0.05; VALUES])?;
+    let mask = grid_mask();
+    let mut network = Vec::new();
+    let mut whole = Vec::new();
+    for run in 0..=repeats.max(1) {
+        let latent: Vec<f32> = (0..config.latent).map(|i| 0.1 * (i as f32 - 2.0)).collect();
+        let start = Instant::now();
+        let z = Tensor::<2>::from_data(TensorData::new(latent, [1, config.latent]), &device);
+        let out: Vec<f32> = model
+            .decode(z)
+            .into_data()
+            .try_into_vec()
+            .map_err(|e| ModelError::Invalid(format!("reading a tensor back failed: {e:?}")))?;
+        let net = start.elapsed().as_secs_f64();
+        let table = reference.unmap(&from_layout(&out), &mask)?;
+        let total = start.elapsed().as_secs_f64();
+        std::hint::black_box(table);
+        if run > 0 {
+            network.push(net);
+            whole.push(total);
+        }
+    }
+    Ok((Timing { runs: network }, Timing { runs: whole }))
+}

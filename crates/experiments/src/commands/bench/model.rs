@@ -1,0 +1,67 @@
+//! `experiments bench model`: training seconds per BRDF for the `cpu` and `paper` presets (and
+//! their ratio), and the time to decode a latent vector into a full MERL table (target:
+//! <= 0.15 s on 2 cores; the paper reports 0.3 s on a GPU, IPCA 0.15 s). All measured in the
+//! same run, on the `--device` backend.
+use deepbrdf_data::Progress;
+use deepbrdf_model::timing;
+use deepbrdf_model::Preset;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Which presets to time: cpu, paper, or both (default).
+    #[arg(long, value_name = "NAME", value_parser = parse_preset)]
+    pub preset: Option<Preset>,
+    /// Latent dimension k.
+    #[arg(long, default_value_t = 10)]
+    pub k: usize,
+    /// BRDFs per training batch (default: each preset's own batch size).
+    #[arg(long)]
+    pub batch: Option<usize>,
+    /// Timed training steps per preset (after one warm-up step).
+    #[arg(long, default_value_t = 3)]
+    pub steps: usize,
+    /// Timed decodes per preset (after one warm-up).
+    #[arg(long, default_value_t = 5)]
+    pub decodes: usize,
+}
+
+fn parse_preset(s: &str) -> Result<Preset, String> {
+    s.parse()
+}
+
+pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
+    let kind = crate::device_arg::kind()?;
+    let device = crate::device_arg::device()?;
+    let presets: Vec<Preset> = match args.preset {
+        Some(p) => vec![p],
+        None => Preset::ALL.to_vec(),
+    };
+    println!("device {kind}, k = {}", args.k);
+    println!(
+        "{:7} {:>6} {:>16} {:>16} {:>14} {:>14}",
+        "preset", "batch", "train s/step", "train s/sample", "decode net s", "decode all s"
+    );
+    let mut per_sample = Vec::new();
+    for preset in presets {
+        let config = preset.train_config(args.k);
+        let batch = args.batch.unwrap_or(config.batch_size);
+        let train = timing::training_steps(&config.model, batch, args.steps, &device)?;
+        let (net, all) = timing::decode(&config.model, args.decodes, &device)?;
+        let step = train.median();
+        println!(
+            "{:7} {:>6} {:>16.3} {:>16.4} {:>14.4} {:>14.4}",
+            preset.name(),
+            batch,
+            step,
+            step / batch as f64,
+            net.median(),
+            all.median()
+        );
+        per_sample.push((preset, step / batch as f64));
+    }
+    if let [(a, ta), (b, tb)] = per_sample[..] {
+        println!("training cost per sample: {b} / {a} = {:.1}x", tb / ta);
+    }
+    println!("(medians; decode = network + inverse layout + inverse eq. (1) to a full MERL table)");
+    Ok(())
+}

@@ -1,0 +1,452 @@
+//! `experiments sweep-k`: the main job. Trains DeepBRDF at each k (default 5, 10, 20, 40) on the
+//! bundled `merl` collection, runs PCA and IPCA at the same k through the evaluation harness
+//! (in-sample as the paper's Fig. 3, or k-fold held out), measures the robustness to missing
+//! phi_d slices (Fig. 2), and writes tables and plots (Figs. 2, 3 and 7) to one folder.
+//!
+//! Models are trained into `<out>/models/fold<F>/k<K>` with resume on: rerunning an interrupted
+//! sweep continues where it stopped, and finished models are loaded, not retrained.
+use crate::data_args::DataArgs;
+use crate::deep_method::{DeepMethod, FitOrigin, FitRecord, NAME};
+use crate::nested_baseline::NestedBaseline;
+use crate::progress_log::ProgressLog;
+use crate::readme_block;
+use crate::robustness::{self, Robustness, NEAREST_FILL};
+use crate::slices_figure::{self, FIG2_MATERIAL};
+use anyhow::{bail, Context};
+use deepbrdf_data::dataset::Dataset;
+use deepbrdf_data::Progress;
+use deepbrdf_eval::figures::write_atomic_file;
+use deepbrdf_eval::harness::{self, HarnessConfig, Materials, Measure, Mode, Results};
+use deepbrdf_model::burn::config::Config as _;
+use deepbrdf_model::{Preset, TrainConfig};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// Marker lines of the README block this command writes (`--update-readme`).
+pub const README_BEGIN: &str = "<!-- sweep-k:begin -->";
+pub const README_END: &str = "<!-- sweep-k:end -->";
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Latent dimensions k to sweep (comma separated).
+    #[arg(long, value_delimiter = ',', default_values_t = [5, 10, 20, 40])]
+    pub ks: Vec<usize>,
+    /// Network and training preset: `cpu` (sized for a 2-core CPU) or `paper` (Table 1 and
+    /// §3.2's training, for a GPU).
+    #[arg(long, default_value = "cpu")]
+    pub preset: Preset,
+    /// Train with this configuration instead of a preset (JSON, as a run's `train_config.json`);
+    /// its k is replaced by each k of the sweep.
+    #[arg(long, value_name = "FILE")]
+    pub train_config: Option<PathBuf>,
+    /// Override the number of training epochs.
+    #[arg(long, value_name = "N")]
+    pub epochs: Option<usize>,
+    /// `in-sample` (fit and evaluate on all materials, the paper's Fig. 3) or `kfold:N`
+    /// (each material evaluated by models that never saw it).
+    #[arg(long, default_value = "in-sample")]
+    pub mode: Mode,
+    /// Output folder [default: results/sweep-k, or results/sweep-k-kfoldN in k-fold mode].
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Seed of the training runs and of the k-fold split.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    #[command(flatten)]
+    pub data: DataArgs,
+    /// Use only the first N materials (in name order).
+    #[arg(long, value_name = "N")]
+    pub limit: Option<usize>,
+    /// The k values whose models are evaluated on reduced inputs (Fig. 2): a comma-separated
+    /// list of swept k, or `all` [default: 10 when swept, else the middle k].
+    #[arg(long, value_name = "LIST")]
+    pub fig2_ks: Option<String>,
+    /// The material shown in the Fig. 2 picture of slices.
+    #[arg(long, value_name = "NAME", default_value = FIG2_MATERIAL)]
+    pub fig2_material: String,
+    /// Rewrite the block between `<!-- sweep-k:begin -->` and `<!-- sweep-k:end -->` in this
+    /// markdown file (e.g. README.md) with the results table and plots.
+    #[arg(long, value_name = "FILE")]
+    pub update_readme: Option<PathBuf>,
+}
+
+impl Args {
+    /// The training configuration of each k.
+    fn config_for(&self) -> anyhow::Result<Box<dyn Fn(usize) -> TrainConfig + Send + Sync>> {
+        let base = match &self.train_config {
+            Some(path) => Some(TrainConfig::load(path).map_err(|e| {
+                anyhow::anyhow!("reading the training configuration {}: {e}", path.display())
+            })?),
+            None => None,
+        };
+        let (preset, epochs, seed) = (self.preset, self.epochs, self.seed);
+        let config_for = move |k: usize| {
+            let mut config = match &base {
+                Some(base) => base.clone(),
+                None => preset.train_config(k),
+            };
+            config.model.latent = k;
+            if let Some(epochs) = epochs {
+                config.epochs = epochs;
+            }
+            config.seed = seed;
+            config
+        };
+        for &k in &self.ks {
+            config_for(k)
+                .validate()
+                .with_context(|| format!("the training configuration for k = {k}"))?;
+        }
+        Ok(Box::new(config_for))
+    }
+
+    /// The k values of the Fig. 2 evaluation.
+    fn fig2_ks(&self) -> anyhow::Result<Vec<usize>> {
+        let default = if self.ks.contains(&10) { 10 } else { self.ks[self.ks.len() / 2] };
+        let ks = match self.fig2_ks.as_deref().map(str::trim) {
+            None => vec![default],
+            Some("all") => self.ks.clone(),
+            Some(list) => list
+                .split(',')
+                .map(|k| k.trim().parse::<usize>())
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|_| {
+                    anyhow::anyhow!("--fig2-ks {list:?}: expected `all` or k values such as 10,20")
+                })?,
+        };
+        if let Some(k) = ks.iter().find(|k| !self.ks.contains(k)) {
+            bail!("--fig2-ks: k = {k} is not among the swept k {:?}", self.ks);
+        }
+        Ok(ks)
+    }
+
+    fn out_dir(&self) -> PathBuf {
+        self.out.clone().unwrap_or_else(|| match self.mode {
+            Mode::KFold { folds } => PathBuf::from(format!("results/sweep-k-kfold{folds}")),
+            _ => PathBuf::from("results/sweep-k"),
+        })
+    }
+
+    fn load_data(&self, progress: &dyn Progress) -> anyhow::Result<Dataset> {
+        let mut data = self.data.load(progress)?;
+        if let Some(n) = self.limit {
+            if n == 0 {
+                bail!("--limit 0 leaves no material");
+            }
+            data.names.truncate(n);
+            data.tables.truncate(n);
+            data.label = format!("{} (first {})", data.label, data.names.len());
+        }
+        Ok(data)
+    }
+}
+
+pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
+    let started = Instant::now();
+    let logged = ProgressLog::new(bars, quiet, Duration::from_secs(30));
+    let progress: &dyn Progress = &logged;
+    if args.mode == Mode::Generalize {
+        bail!("sweep-k runs in-sample or kfold:N, not generalize");
+    }
+    let harness_config = HarnessConfig {
+        ks: args.ks.clone(),
+        mode: args.mode,
+        seed: args.seed,
+        measures: Measure::ALL.to_vec(),
+    };
+    harness_config.validate()?;
+    let config_for = args.config_for()?;
+    let fig2_ks = args.fig2_ks()?;
+    let kind = crate::device_arg::kind()?;
+    let device = crate::device_arg::device()?;
+    let out = args.out_dir();
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let models_dir = out.join("models");
+
+    let data = args.load_data(progress)?;
+    let loaded_at = started.elapsed().as_secs_f64();
+    let sample = config_for(args.ks[0]);
+    let training = match &args.train_config {
+        Some(path) => format!("configuration {}", path.display()),
+        None => format!("preset {}", args.preset),
+    };
+    let training = format!(
+        "{training}, {} epochs, batch {}, lr {:.1e}, seed {}, device {kind}",
+        sample.epochs, sample.batch_size, sample.learning_rate, args.seed
+    );
+    println!(
+        "sweep-k: {} materials ({}), k = {:?}, {} mode, {training}; output in {}",
+        data.names.len(),
+        data.label,
+        args.ks,
+        args.mode,
+        out.display()
+    );
+
+    let (pca, ipca) = (NestedBaseline::pca(), NestedBaseline::ipca());
+    let deep = DeepMethod::new(config_for, &models_dir, &data.label, device.clone());
+    let materials = Materials { names: &data.names, tables: &data.tables, label: &data.label };
+    let results = harness::run(&[&pca, &ipca, &deep], &harness_config, materials, None, progress)?;
+    results.write(&out)?;
+
+    let folds = args.mode.folds(data.names.len(), data.names.len(), args.seed)?;
+    let robustness = robustness::measure(
+        &data.names,
+        &data.tables,
+        &folds,
+        &deep,
+        &fig2_ks,
+        &results,
+        progress,
+    )?;
+    robustness.write(&out)?;
+
+    let fig2 = fig2_picture(&args, &data, &folds, &deep, &out)?;
+    let fits = deep.fits();
+    write_training_csv(&fits, &out)?;
+
+    let wall = started.elapsed().as_secs_f64();
+    let report = Report {
+        args: &args,
+        results: &results,
+        robustness: &robustness,
+        fits: &fits,
+        training: &training,
+        fig2: fig2.as_deref(),
+        loaded_at,
+        wall,
+    };
+    write_atomic_file(&out.join("summary.md"), report.summary_markdown().as_bytes())?;
+    if let Some(readme) = &args.update_readme {
+        let block = report.readme_block(readme, &out)?;
+        readme_block::update_file(readme, README_BEGIN, README_END, &block)?;
+        println!("updated the results block of {}", readme.display());
+    }
+    print!("{}", report.printed());
+    println!("wrote {}; total wall time {}", out.display(), minutes(wall));
+    Ok(())
+}
+
+/// The Fig. 2 picture for `--fig2-material` (skipped with a note when it is not in the data),
+/// at k = 10 when swept (else the middle k), by the model of the fold that evaluates it.
+fn fig2_picture(
+    args: &Args,
+    data: &Dataset,
+    folds: &[harness::Fold],
+    deep: &DeepMethod,
+    out: &Path,
+) -> anyhow::Result<Option<String>> {
+    let Some(i) = data.names.iter().position(|n| n == &args.fig2_material) else {
+        println!("note: {} is not among the materials; no Fig. 2 picture", args.fig2_material);
+        return Ok(None);
+    };
+    let k = if args.ks.contains(&10) { 10 } else { args.ks[args.ks.len() / 2] };
+    let fold = folds.iter().find(|f| f.test.contains(&i)).map_or(0, |f| f.index);
+    let model = deep
+        .model(fold, k)
+        .with_context(|| format!("no {NAME} model was fitted for fold {fold} at k = {k}"))?;
+    slices_figure::write(&model, &data.tables[i], &out.join("fig2_slices.png"))?;
+    Ok(Some(format!("{} (k = {k})", args.fig2_material)))
+}
+
+fn write_training_csv(fits: &[FitRecord], out: &Path) -> anyhow::Result<()> {
+    let mut csv = String::from("fold,k,origin,call_seconds,train_seconds,final_train_mse,dir\n");
+    for f in fits {
+        let _ = writeln!(
+            csv,
+            "{},{},{},{:.2},{:.2},{:e},{}",
+            f.fold,
+            f.k,
+            origin_name(f.origin),
+            f.seconds,
+            f.train_seconds,
+            f.final_mse,
+            f.dir.display()
+        );
+    }
+    write_atomic_file(&out.join("training.csv"), csv.as_bytes())?;
+    Ok(())
+}
+
+fn origin_name(origin: FitOrigin) -> &'static str {
+    match origin {
+        FitOrigin::Loaded => "loaded",
+        FitOrigin::Trained => "trained",
+    }
+}
+
+fn minutes(seconds: f64) -> String {
+    format!("{:.0} min {:02.0} s ({seconds:.1} s)", (seconds / 60.0).floor(), seconds % 60.0)
+}
+
+/// Everything the summaries are made of.
+struct Report<'a> {
+    args: &'a Args,
+    results: &'a Results,
+    robustness: &'a Robustness,
+    fits: &'a [FitRecord],
+    training: &'a str,
+    fig2: Option<&'a str>,
+    loaded_at: f64,
+    wall: f64,
+}
+
+impl Report<'_> {
+    /// The paper's claims (§4 and Fig. 2) checked against this run's means.
+    fn claims(&self) -> String {
+        let mut s = String::new();
+        let m = |method: &str, k: usize| self.results.mean(method, k, Measure::MappedMse);
+        let ks = &self.args.ks;
+        let Some(&k0) = ks.iter().find(|&&k| k == 10).or(ks.first()) else { return s };
+        if let (Some(d), Some(i), Some(p)) = (m(NAME, k0), m("IPCA", k0), m("PCA", k0)) {
+            let _ = writeln!(
+                s,
+                "- k = {k0}: {NAME} {d:.4e} vs IPCA {i:.4e} ({:.2}x) and PCA {p:.4e} ({:.2}x): {NAME} is {} both.",
+                i / d,
+                p / d,
+                if d < i && d < p { "below" } else { "NOT below" }
+            );
+            for &k in ks.iter().filter(|&&k| k > k0) {
+                if let Some(i) = m("IPCA", k) {
+                    let _ = writeln!(
+                        s,
+                        "- {NAME} at k = {k0} vs IPCA at k = {k}: {d:.4e} vs {i:.4e} ({}).",
+                        if d <= i { "DeepBRDF lower or equal" } else { "IPCA lower" }
+                    );
+                }
+            }
+        }
+        for &k in &self.robustness.ks {
+            for every in robustness::SELECTIONS {
+                let fill = self.robustness.mean(every, NEAREST_FILL, None);
+                let deep = self.robustness.mean(every, NAME, Some(k));
+                if let (Some(f), Some(d)) = (fill, deep) {
+                    let _ = writeln!(
+                        s,
+                        "- 1/{every} of the slices, k = {k}: {NAME} {d:.4e} vs {NEAREST_FILL} {f:.4e}: {NAME} is {}.",
+                        if d < f { "better" } else { "NOT better" }
+                    );
+                }
+            }
+        }
+        s
+    }
+
+    fn training_table(&self) -> String {
+        let mut s = String::from(
+            "| fold | k | model | training s (recorded) | this run s | final training MSE |\n|---:|---:|---|---:|---:|---:|\n",
+        );
+        for f in self.fits {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {:.0} | {:.1} | {:.4e} |",
+                f.fold,
+                f.k,
+                origin_name(f.origin),
+                f.train_seconds,
+                f.seconds,
+                f.final_mse
+            );
+        }
+        s
+    }
+
+    fn summary_markdown(&self) -> String {
+        let mut s = String::from("# sweep-k\n\n");
+        let _ = writeln!(s, "DeepBRDF: {}.\n", self.training);
+        let _ = writeln!(s, "## Checks against the paper\n\n{}", self.claims());
+        s.push_str(&self.results.summary_markdown().replacen("# ", "## ", 1));
+        s.push_str(&self.robustness.markdown(self.results.materials().len(), self.fig2));
+        let _ = writeln!(s, "## DeepBRDF training\n\n{}", self.training_table());
+        let _ = writeln!(
+            s,
+            "Data loading {:.1} s; total wall time {}.",
+            self.loaded_at,
+            minutes(self.wall)
+        );
+        s
+    }
+
+    /// The README block: the mapped-space table, the robustness table, the plots (linked
+    /// relative to the README's folder).
+    fn readme_block(&self, readme: &Path, out: &Path) -> anyhow::Result<String> {
+        let link = relative_link(readme, out)?;
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "Written by `experiments sweep-k` ({} mode, {} materials of {}; DeepBRDF {}; total wall time {}).\n",
+            self.results.mode,
+            self.results.materials().len(),
+            self.results.train_label,
+            self.training,
+            minutes(self.wall)
+        );
+        let _ = writeln!(s, "Mean MSE in the eq. (1) mapped space (Fig. 3):\n");
+        s.push_str(&mapped_table(self.results));
+        let _ = writeln!(s, "\n{}", self.claims());
+        let _ = writeln!(s, "![error vs k (Fig. 3)]({link}/error_vs_k_mapped_mse.png)\n");
+        let _ = writeln!(s, "![per-material error (Fig. 7)]({link}/per_material_mapped_mse.png)\n");
+        let _ =
+            writeln!(s, "Robustness to missing phi_d slices (Fig. 2), mean mapped-space MSE:\n");
+        s.push_str(&self.robustness.table());
+        let _ = writeln!(s, "\n![robustness (Fig. 2)]({link}/robustness.png)\n");
+        if self.fig2.is_some() {
+            let _ = writeln!(s, "![slices (Fig. 2)]({link}/fig2_slices.png)\n");
+        }
+        let _ = writeln!(s, "Details: [{link}/summary.md]({link}/summary.md).");
+        Ok(s)
+    }
+
+    fn printed(&self) -> String {
+        let mut s = String::from("\n");
+        s.push_str(&self.results.summary_table());
+        let _ = writeln!(
+            s,
+            "Robustness (Fig. 2), mean mapped-space MSE:\n\n{}",
+            self.robustness.table()
+        );
+        let _ = writeln!(s, "DeepBRDF training:\n\n{}", self.training_table());
+        let _ = writeln!(s, "Checks against the paper:\n{}", self.claims());
+        let _ = writeln!(
+            s,
+            "Evaluation (encode, decode, measure) {:.1} s; robustness {:.1} s.",
+            self.results.eval_seconds, self.robustness.seconds
+        );
+        s
+    }
+}
+
+/// The mapped-space table only (the harness's summary has one table per measure).
+fn mapped_table(results: &Results) -> String {
+    let mut s = String::from("| method |");
+    results.ks.iter().for_each(|k| {
+        let _ = write!(s, " k = {k} |");
+    });
+    s.push_str("\n|---|");
+    results.ks.iter().for_each(|_| s.push_str("---:|"));
+    s.push('\n');
+    for method in &results.methods {
+        let _ = write!(s, "| {method} |");
+        for &k in &results.ks {
+            match results.mean(method, k, Measure::MappedMse) {
+                Some(v) => {
+                    let _ = write!(s, " {v:.4e} |");
+                }
+                None => s.push_str(" - |"),
+            }
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// `out` as a link from the folder of `readme`: relative when inside it, else absolute.
+fn relative_link(readme: &Path, out: &Path) -> anyhow::Result<String> {
+    let out = out.canonicalize().with_context(|| format!("resolving {}", out.display()))?;
+    let readme =
+        readme.canonicalize().with_context(|| format!("resolving {}", readme.display()))?;
+    let base = readme.parent().unwrap_or(Path::new("/"));
+    let path = out.strip_prefix(base).map(Path::to_path_buf).unwrap_or(out);
+    Ok(path.to_string_lossy().replace('\\', "/"))
+}

@@ -1,0 +1,151 @@
+//! `experiments train`: train DeepBRDF (§3.2) on a dataset and save the model artifact.
+//!
+//! `experiments train --k 10 [--preset cpu|paper] [--epochs N] [--batch N] [--lr X] [--seed S]
+//! [--slice-dropout P] --out DIR` starts a run; `--resume DIR` (or `--out DIR --resume`)
+//! continues an interrupted one exactly where its last checkpoint left it, with the settings
+//! saved in its checkpoint. The model is written to `DIR/model`; `DIR/train_log.csv` has one row
+//! per epoch.
+use crate::data_args::DataArgs;
+use anyhow::{bail, Context};
+use deepbrdf_data::Progress;
+use deepbrdf_model::burn::config::Config;
+use deepbrdf_model::train::{checkpoint_path, saved_config};
+use deepbrdf_model::{fit, Preset, SliceDropoutConfig, TrainConfig};
+use std::path::PathBuf;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Latent dimension k (§3.2 studies 5 to 40).
+    #[arg(long, default_value_t = 10)]
+    pub k: usize,
+    /// cpu (sized for a 2-core CPU, see README) or paper (Table 1, lr 2e-5, batch 32,
+    /// 1000 epochs: for GPUs).
+    #[arg(long, default_value = "cpu", value_parser = parse_preset)]
+    pub preset: Preset,
+    /// A training configuration (JSON, as saved in DIR/train_config.json) instead of a preset.
+    #[arg(long, value_name = "FILE", conflicts_with = "preset")]
+    pub config: Option<PathBuf>,
+    /// Epochs (default: the preset's).
+    #[arg(long)]
+    pub epochs: Option<usize>,
+    /// BRDFs per batch (default: the preset's).
+    #[arg(long)]
+    pub batch: Option<usize>,
+    /// Initial learning rate (default: the preset's).
+    #[arg(long)]
+    pub lr: Option<f64>,
+    /// Seed of the initialisation, the shuffling and the augmentation.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Slice-dropout augmentation: the probability that an input loses phi_d slices (each
+    /// missing one filled from its nearest kept one; the target stays whole).
+    #[arg(long, value_name = "P")]
+    pub slice_dropout: Option<f64>,
+    /// Slice selections drawn from for slice dropout (every:N or random:K, comma-separated).
+    #[arg(long, value_name = "LIST", value_delimiter = ',', default_value = "every:3,every:9")]
+    pub slice_dropout_keep: Vec<String>,
+    /// Output directory (checkpoint, log, configuration, and the model in DIR/model).
+    #[arg(long, value_name = "DIR", required_unless_present = "resume")]
+    pub out: Option<PathBuf>,
+    /// Continue the interrupted run in DIR (or in --out), with its saved settings.
+    #[arg(long, value_name = "DIR", num_args = 0..=1)]
+    pub resume: Option<Option<PathBuf>>,
+    #[command(flatten)]
+    pub data: DataArgs,
+}
+
+fn parse_preset(s: &str) -> Result<Preset, String> {
+    s.parse()
+}
+
+impl Args {
+    /// The configuration of a new run from the preset (or file) and the overrides.
+    fn config(&self) -> anyhow::Result<TrainConfig> {
+        let mut config = match &self.config {
+            Some(path) => TrainConfig::load(path).map_err(|e| {
+                anyhow::anyhow!("{}: not a training configuration: {e}", path.display())
+            })?,
+            None => self.preset.train_config(self.k),
+        };
+        if self.config.is_some() && self.k != config.model.latent {
+            config.model.latent = self.k;
+        }
+        if let Some(e) = self.epochs {
+            config.epochs = e;
+        }
+        if let Some(b) = self.batch {
+            config.batch_size = b;
+        }
+        if let Some(lr) = self.lr {
+            config.learning_rate = lr;
+        }
+        config.seed = self.seed;
+        if let Some(p) = self.slice_dropout {
+            config.slice_dropout = Some(
+                SliceDropoutConfig::new()
+                    .with_probability(p)
+                    .with_selections(self.slice_dropout_keep.clone()),
+            );
+        }
+        config.validate()?;
+        Ok(config)
+    }
+}
+
+pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
+    let device = crate::device_arg::device()?;
+    let kind = crate::device_arg::kind()?;
+    let resume_dir = args.resume.clone().map(|d| d.or_else(|| args.out.clone()));
+    let (out, config, resume) = match resume_dir {
+        Some(None) => bail!("--resume needs a directory (--resume DIR or --out DIR --resume)"),
+        Some(Some(dir)) => {
+            if !checkpoint_path(&dir).is_file() {
+                bail!("{}: no interrupted run to resume (no checkpoint.bin)", dir.display());
+            }
+            let config = saved_config(&dir)?;
+            eprintln!(
+                "resuming {} (k = {}, {} epochs, batch {}, lr {:e})",
+                dir.display(),
+                config.model.latent,
+                config.epochs,
+                config.batch_size,
+                config.learning_rate
+            );
+            (dir, config, true)
+        }
+        None => {
+            let out = args.out.clone().context("--out DIR is required")?;
+            if checkpoint_path(&out).exists() {
+                bail!(
+                    "{} already holds a training run; continue it with --resume {} or choose \
+                     another --out",
+                    out.display(),
+                    out.display()
+                );
+            }
+            (out, args.config()?, false)
+        }
+    };
+    let data = args.data.load(progress)?;
+    eprintln!(
+        "training DeepBRDF k = {} on {} ({} BRDFs), {} epochs of batches of {}, on {kind}",
+        config.model.latent,
+        data.label,
+        data.len(),
+        config.epochs,
+        config.batch_size
+    );
+    let tables: Vec<_> = data.tables.iter().collect();
+    let model = fit(&config, &data.label, &data.names, &tables, &out, resume, progress, &device)?;
+    let p = model.provenance();
+    println!(
+        "trained {} epochs in {:.0} s: final loss {:.4e}, mapped-space MSE {:.4e} over {} BRDFs",
+        p.epochs,
+        p.train_seconds,
+        p.final_loss,
+        p.final_mse,
+        p.materials.len()
+    );
+    println!("model {} written to {}", model.id(), out.join("model").display());
+    Ok(())
+}

@@ -1,0 +1,305 @@
+//! DeepBRDF (Hu et al., CGF 2020, §3.2) as a method of the evaluation harness, so it runs
+//! through `deepbrdf_eval::harness::run` exactly like PCA and IPCA (§4, Figs. 3 and 7).
+//!
+//! Each (fold, k) is trained into its own directory `<models>/fold<F>/k<K>` with resume on: an
+//! interrupted sweep continues where it stopped, and a finished model whose provenance matches
+//! (same configuration, data label and materials) is loaded, not retrained.
+
+use crate::mapped_input::InputCache;
+use deepbrdf_data::{MerlTable, Progress};
+use deepbrdf_eval::harness::{Codec, Method, TrainingSet};
+use deepbrdf_eval::{EvalError, Result};
+use deepbrdf_model::artifact::MODEL_DIR;
+use deepbrdf_model::burn::tensor::Device;
+use deepbrdf_model::{DeepBrdf, TrainConfig};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+
+/// The method's name in tables and plots.
+pub const NAME: &str = "DeepBRDF";
+
+/// The training configuration of one k: a function of k (a preset, possibly with overrides).
+pub type ConfigFor = dyn Fn(usize) -> TrainConfig + Send + Sync;
+
+/// How a fit of one (fold, k) came about.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FitOrigin {
+    /// A finished model was found and loaded.
+    Loaded,
+    /// The model was trained (from scratch or resumed from a checkpoint).
+    Trained,
+}
+
+/// One fitted (fold, k): where it lives and how long it took.
+#[derive(Clone, Debug)]
+pub struct FitRecord {
+    pub fold: usize,
+    pub k: usize,
+    pub dir: PathBuf,
+    pub origin: FitOrigin,
+    /// Wall seconds of this call (loading, or mapping + training + saving).
+    pub seconds: f64,
+    /// Seconds of training recorded in the model's provenance (over all resumed pieces).
+    pub train_seconds: f64,
+    /// Final mapped-space training MSE recorded in the provenance.
+    pub final_mse: f64,
+}
+
+/// DeepBRDF as a harness [`Method`].
+///
+/// Folds are numbered in the order the harness fits them (its folds are deterministic in the
+/// seed, so a rerun with the same settings finds the same directories).
+pub struct DeepMethod {
+    config_for: Box<ConfigFor>,
+    models_dir: PathBuf,
+    label: String,
+    device: Device,
+    /// The fold the next [`Method::fit_fold`] call fits.
+    next_fold: AtomicUsize,
+    fits: Mutex<Vec<FitRecord>>,
+    models: Mutex<Vec<(usize, usize, Arc<DeepBrdf>)>>,
+}
+
+impl DeepMethod {
+    /// A method training with `config_for(k)` into `models_dir`, on data labelled `label` (the
+    /// label is recorded in each model's provenance).
+    pub fn new(config_for: Box<ConfigFor>, models_dir: &Path, label: &str, device: Device) -> Self {
+        Self {
+            config_for,
+            models_dir: models_dir.to_path_buf(),
+            label: label.to_string(),
+            device,
+            next_fold: AtomicUsize::new(0),
+            fits: Mutex::new(Vec::new()),
+            models: Mutex::new(Vec::new()),
+        }
+    }
+
+    /// The training directory of (fold, k).
+    pub fn dir(models_dir: &Path, fold: usize, k: usize) -> PathBuf {
+        models_dir.join(format!("fold{fold}")).join(format!("k{k}"))
+    }
+
+    /// The fits made so far, in order.
+    pub fn fits(&self) -> Vec<FitRecord> {
+        self.fits.lock().map(|f| f.clone()).unwrap_or_default()
+    }
+
+    /// The model fitted for (fold, k), once the harness has fitted it.
+    pub fn model(&self, fold: usize, k: usize) -> Option<Arc<DeepBrdf>> {
+        let models = self.models.lock().ok()?;
+        models.iter().find(|(f, kk, _)| *f == fold && *kk == k).map(|(_, _, m)| m.clone())
+    }
+
+    /// Loads or trains the model of (fold, k) on `tables`.
+    fn fit_in(
+        &self,
+        fold: usize,
+        tables: &[&MerlTable],
+        names: &[String],
+        k: usize,
+        cache: &Arc<InputCache>,
+        progress: &dyn Progress,
+    ) -> Result<Box<dyn Codec>> {
+        let started = std::time::Instant::now();
+        let config = (self.config_for)(k);
+        if config.model.latent != k {
+            return Err(EvalError::Invalid(format!(
+                "the training configuration for k = {k} has k = {}",
+                config.model.latent
+            )));
+        }
+        let dir = Self::dir(&self.models_dir, fold, k);
+        let (model, origin) = match self.load_finished(&dir, &config, names)? {
+            Some(model) => (model, FitOrigin::Loaded),
+            None => {
+                progress.status(&format!("fold {fold}"));
+                let model = deepbrdf_model::fit(
+                    &config,
+                    &self.label,
+                    names,
+                    tables,
+                    &dir,
+                    true,
+                    progress,
+                    &self.device,
+                )
+                .map_err(|e| model_error(&dir, e))?;
+                (model, FitOrigin::Trained)
+            }
+        };
+        let provenance = model.provenance();
+        let record = FitRecord {
+            fold,
+            k,
+            dir,
+            origin,
+            seconds: started.elapsed().as_secs_f64(),
+            train_seconds: provenance.train_seconds,
+            final_mse: provenance.final_mse,
+        };
+        if let Ok(mut fits) = self.fits.lock() {
+            fits.push(record);
+        }
+        let model = Arc::new(model);
+        let mut models = self.models.lock().map_err(|_| poisoned())?;
+        // Codecs of one fold share the mapped input of the table being evaluated when their
+        // models map with the same eq. (1) reference (they do: one fold, one training set).
+        let same_reference = models
+            .iter()
+            .filter(|(f, kk, _)| *f == fold && *kk != k)
+            .all(|(_, _, m)| m.reference().values() == model.reference().values());
+        let cache = if same_reference { cache.clone() } else { Arc::default() };
+        models.retain(|(f, kk, _)| (*f, *kk) != (fold, k));
+        models.push((fold, k, model.clone()));
+        Ok(Box::new(DeepCodec { model, cache }))
+    }
+
+    /// The finished model in `dir` if there is one trained with `config` on `names` from this
+    /// method's data label; `None` when there is none or it belongs to another run (then
+    /// training resumes or restarts, and the trainer reports a conflicting checkpoint).
+    fn load_finished(
+        &self,
+        dir: &Path,
+        config: &TrainConfig,
+        names: &[String],
+    ) -> Result<Option<DeepBrdf>> {
+        if !dir.join(MODEL_DIR).is_dir() {
+            return Ok(None);
+        }
+        let model = match DeepBrdf::load(dir, &self.device) {
+            Ok(model) => model,
+            Err(e) => {
+                // The trainer rebuilds the artifact from the checkpoint.
+                eprintln!("note: not reusing the model in {}: {e}", dir.display());
+                return Ok(None);
+            }
+        };
+        let wanted = serde_json::to_value(config).map_err(|e| {
+            EvalError::Invalid(format!("cannot serialise the training configuration: {e}"))
+        })?;
+        let p = model.provenance();
+        let mismatch = if !json_close(&p.train_config, &wanted) {
+            Some("it was trained with another configuration")
+        } else if p.data_label != self.label || p.materials != names {
+            Some("it was trained on other materials")
+        } else if p.epochs != config.epochs {
+            Some("it has another number of epochs")
+        } else {
+            None
+        };
+        if let Some(why) = mismatch {
+            eprintln!("note: not reusing the model in {}: {why}", dir.display());
+            return Ok(None);
+        }
+        Ok(Some(model))
+    }
+}
+
+/// JSON equality up to the last digits of floating-point numbers (a float written as JSON and
+/// parsed back may differ in its last bit).
+fn json_close(a: &serde_json::Value, b: &serde_json::Value) -> bool {
+    use serde_json::Value;
+    match (a, b) {
+        (Value::Number(x), Value::Number(y)) => match (x.as_f64(), y.as_f64()) {
+            (Some(x), Some(y)) => x == y || (x - y).abs() <= 1e-12 * x.abs().max(y.abs()),
+            _ => x == y,
+        },
+        (Value::Array(x), Value::Array(y)) => {
+            x.len() == y.len() && x.iter().zip(y).all(|(x, y)| json_close(x, y))
+        }
+        (Value::Object(x), Value::Object(y)) => {
+            x.len() == y.len() && x.iter().all(|(k, v)| y.get(k).is_some_and(|w| json_close(v, w)))
+        }
+        _ => a == b,
+    }
+}
+
+fn poisoned() -> EvalError {
+    EvalError::Invalid(format!("{NAME}: a lock was poisoned by an earlier panic"))
+}
+
+fn model_error(dir: &Path, e: deepbrdf_model::ModelError) -> EvalError {
+    EvalError::method(format!("{NAME} in {}", dir.display()), e)
+}
+
+impl Method for DeepMethod {
+    fn name(&self) -> String {
+        NAME.to_string()
+    }
+
+    /// Fits into the directory of the fold currently being fitted.
+    fn fit(
+        &self,
+        train: &[&MerlTable],
+        names: &[String],
+        k: usize,
+        progress: &dyn Progress,
+    ) -> Result<Box<dyn Codec>> {
+        let fold = self.next_fold.load(Ordering::SeqCst);
+        self.fit_in(fold, train, names, k, &Arc::default(), progress)
+    }
+
+    fn fit_fold(
+        &self,
+        train: &TrainingSet<'_>,
+        ks: &[usize],
+        progress: &dyn Progress,
+    ) -> Result<Vec<Box<dyn Codec>>> {
+        let fold = self.next_fold.load(Ordering::SeqCst);
+        let cache = Arc::new(InputCache::default());
+        let codecs = ks
+            .iter()
+            .map(|&k| self.fit_in(fold, train.tables, train.names, k, &cache, progress))
+            .collect::<Result<Vec<_>>>()?;
+        self.next_fold.store(fold + 1, Ordering::SeqCst);
+        Ok(codecs)
+    }
+}
+
+/// A trained DeepBRDF model as a harness [`Codec`]: eq. (2) to encode, eq. (3) to decode.
+pub struct DeepCodec {
+    model: Arc<DeepBrdf>,
+    cache: Arc<InputCache>,
+}
+
+impl Codec for DeepCodec {
+    fn name(&self) -> String {
+        format!("{NAME}-{}", self.model.k())
+    }
+
+    fn k(&self) -> usize {
+        self.model.k()
+    }
+
+    fn encode(&self, table: &MerlTable) -> Result<Vec<f32>> {
+        let input = self.cache.get(table, self.model.reference());
+        input.encode(&self.model).map_err(|e| EvalError::method(self.name(), e))
+    }
+
+    fn decode(&self, code: &[f32]) -> Result<MerlTable> {
+        self.model.decode(code).map_err(|e| EvalError::method(self.name(), e))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn configurations_compare_up_to_float_round_off() {
+        let a = json!({"lr": 1e-3, "beta": 0.8999999761581421, "layers": [1, 2], "name": "cpu"});
+        let b = json!({"lr": 1.0000000000000002e-3, "beta": 0.8999999761581421, "layers": [1, 2], "name": "cpu"});
+        assert!(json_close(&a, &b));
+        for c in [
+            json!({"lr": 1.1e-3, "beta": 0.8999999761581421, "layers": [1, 2], "name": "cpu"}),
+            json!({"lr": 1e-3, "beta": 0.8999999761581421, "layers": [1, 3], "name": "cpu"}),
+            json!({"lr": 1e-3, "beta": 0.8999999761581421, "layers": [1, 2], "name": "paper"}),
+            json!({"lr": 1e-3, "beta": 0.8999999761581421, "layers": [1, 2]}),
+        ] {
+            assert!(!json_close(&a, &c), "{c}");
+        }
+    }
+}

@@ -1,0 +1,269 @@
+//! Robustness to missing phi_d slices (Hu et al., CGF 2020, §3.2 and Fig. 2): DeepBRDF encodes a
+//! BRDF of which only every 3rd or every 9th phi_d slice is known (each missing slice filled
+//! from its nearest kept one, "currently, the slices are equally spaced"), and its
+//! reconstruction is compared with the filled input itself (the baseline: nearest-slice fill)
+//! and with DeepBRDF's reconstruction from the full input.
+//!
+//! All errors are MSEs in the eq. (1) mapped space over the original's valid cells, with the
+//! median of the model's training tables as reference: the harness's [`Yardstick`], so the
+//! numbers sit on the same scale as Fig. 3's.
+
+use crate::deep_method::{DeepMethod, NAME};
+use crate::mapped_input::MappedInput;
+use deepbrdf_data::augment::{kept_slices, SliceSelection};
+use deepbrdf_data::{MerlTable, Progress};
+use deepbrdf_eval::figures::{write_atomic_file, write_chart, LineChart, Series};
+use deepbrdf_eval::harness::{Fold, Measure, Results, Yardstick};
+use deepbrdf_model::DeepBrdf;
+use std::fmt::Write as _;
+use std::path::Path;
+use std::sync::Arc;
+
+/// The label of the baseline in tables and plots.
+pub const NEAREST_FILL: &str = "nearest-slice fill";
+
+/// The reduced inputs of Fig. 2: every 3rd and every 9th slice.
+pub const SELECTIONS: [usize; 2] = [3, 9];
+
+/// One measured value.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RobustnessRecord {
+    /// Keep every n-th slice (1: the full input).
+    pub every: usize,
+    /// [`NEAREST_FILL`] or [`NAME`].
+    pub method: String,
+    /// k of the DeepBRDF model (`None` for the fill baseline).
+    pub k: Option<usize>,
+    pub fold: usize,
+    pub material: String,
+    pub mapped_mse: f64,
+}
+
+/// All robustness numbers of a run.
+#[derive(Clone, Debug, Default)]
+pub struct Robustness {
+    pub ks: Vec<usize>,
+    pub records: Vec<RobustnessRecord>,
+    pub seconds: f64,
+}
+
+/// Label of an input fraction.
+pub fn fraction_label(every: usize) -> String {
+    if every == 1 {
+        "all slices".into()
+    } else {
+        format!("1/{every} of the slices")
+    }
+}
+
+/// Measures, for every fold and each of its evaluated materials, the nearest-fill baseline and
+/// DeepBRDF at each of `ks` from the reduced inputs of [`SELECTIONS`]. DeepBRDF's numbers from
+/// the full input are taken from the harness's `results` (same models, same yardstick).
+#[allow(clippy::too_many_arguments)]
+pub fn measure(
+    names: &[String],
+    tables: &[MerlTable],
+    folds: &[Fold],
+    deep: &DeepMethod,
+    ks: &[usize],
+    results: &Results,
+    progress: &dyn Progress,
+) -> anyhow::Result<Robustness> {
+    let started = std::time::Instant::now();
+    let mut records = Vec::new();
+    let kept: Vec<(usize, Vec<usize>)> =
+        SELECTIONS.iter().map(|&n| (n, kept_slices(&SliceSelection::Every(n), 0))).collect();
+    let steps: usize = folds.iter().map(|f| f.test.len()).sum::<usize>() * SELECTIONS.len();
+    progress.start(steps as u64, "Fig. 2 robustness");
+    for fold in folds {
+        let models: Vec<Arc<DeepBrdf>> = ks
+            .iter()
+            .map(|&k| {
+                deep.model(fold.index, k).ok_or_else(|| {
+                    anyhow::anyhow!("no {NAME} model was fitted for fold {} at k = {k}", fold.index)
+                })
+            })
+            .collect::<anyhow::Result<_>>()?;
+        let Some(first) = models.first() else { break };
+        if let Some(m) =
+            models.iter().find(|m| m.reference().values() != first.reference().values())
+        {
+            anyhow::bail!(
+                "the k = {} and k = {} models of fold {} map with different references",
+                first.k(),
+                m.k(),
+                fold.index
+            );
+        }
+        let yardstick = Yardstick::from_reference(first.reference().clone());
+        for &i in &fold.test {
+            let (name, table) = (&names[i], &tables[i]);
+            let original = yardstick.original(table);
+            // Every model of the fold maps with the fold's reference: map the table once.
+            let input = MappedInput::new(table, first.reference());
+            let mut push = |every: usize, method: &str, k: Option<usize>, value: f64| {
+                records.push(RobustnessRecord {
+                    every,
+                    method: method.to_string(),
+                    k,
+                    fold: fold.index,
+                    material: name.clone(),
+                    mapped_mse: value,
+                })
+            };
+            for &k in ks {
+                let full = results
+                    .records
+                    .iter()
+                    .find(|r| {
+                        r.method == NAME
+                            && r.k == k
+                            && r.measure == Measure::MappedMse
+                            && &r.material == name
+                    })
+                    .map(|r| r.value)
+                    .ok_or_else(|| anyhow::anyhow!("no {NAME} result for {name} at k = {k}"))?;
+                push(1, NAME, Some(k), full);
+            }
+            for (every, kept) in &kept {
+                let filled = table.with_kept_slices(kept);
+                let value = yardstick.measure(&original, &filled, &[Measure::MappedMse])?[0];
+                push(*every, NEAREST_FILL, None, value);
+                for model in &models {
+                    let latent = input.encode_partial(model, kept)?;
+                    let recon = model.decode(&latent)?;
+                    let value = yardstick.measure(&original, &recon, &[Measure::MappedMse])?[0];
+                    push(*every, NAME, Some(model.k()), value);
+                }
+                progress.advance(1);
+            }
+        }
+    }
+    progress.finish();
+    Ok(Robustness { ks: ks.to_vec(), records, seconds: started.elapsed().as_secs_f64() })
+}
+
+impl Robustness {
+    /// Mean over materials of the records of (`every`, `method`, `k`).
+    pub fn mean(&self, every: usize, method: &str, k: Option<usize>) -> Option<f64> {
+        let v: Vec<f64> = self
+            .records
+            .iter()
+            .filter(|r| r.every == every && r.method == method && r.k == k)
+            .map(|r| r.mapped_mse)
+            .collect();
+        (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+    }
+
+    /// The rows of the table: the fill baseline, then DeepBRDF at each k.
+    fn rows(&self) -> Vec<(String, &'static str, Option<usize>)> {
+        let mut rows = vec![(NEAREST_FILL.to_string(), NEAREST_FILL, None)];
+        rows.extend(self.ks.iter().map(|&k| (format!("{NAME} k = {k}"), NAME, Some(k))));
+        rows
+    }
+
+    /// Columns: the full input, then each reduced one.
+    fn columns() -> Vec<usize> {
+        std::iter::once(1).chain(SELECTIONS).collect()
+    }
+
+    /// The markdown table of mean mapped-space MSEs (rows: methods; columns: inputs). The fill
+    /// baseline is exact on the full input (0).
+    pub fn table(&self) -> String {
+        let mut s = String::from("| input → | all slices |");
+        for n in SELECTIONS {
+            let _ = write!(s, " 1/{n} of the slices |");
+        }
+        s.push_str("\n|---|---:|");
+        SELECTIONS.iter().for_each(|_| s.push_str("---:|"));
+        s.push('\n');
+        for (label, method, k) in self.rows() {
+            let _ = write!(s, "| {label} |");
+            for every in Self::columns() {
+                let v =
+                    if every == 1 && k.is_none() { Some(0.0) } else { self.mean(every, method, k) };
+                match v {
+                    Some(v) if v == 0.0 => s.push_str(" 0 (exact) |"),
+                    Some(v) => {
+                        let _ = write!(s, " {v:.4e} |");
+                    }
+                    None => s.push_str(" - |"),
+                }
+            }
+            s.push('\n');
+        }
+        s
+    }
+
+    /// The markdown section: what was measured, the table, the plot and the slices figure.
+    pub fn markdown(&self, materials: usize, fig2_material: Option<&str>) -> String {
+        let mut s = String::from("## Robustness to missing phi_d slices (Fig. 2)\n\n");
+        let _ = writeln!(
+            s,
+            "Mean mapped-space MSE (eq. 1) over {materials} materials. Reduced inputs keep every \
+             3rd or 9th phi_d slice (equally spaced, as the paper); each missing slice is filled \
+             from its nearest kept one. `{NEAREST_FILL}` is that filled input itself; DeepBRDF \
+             encodes the filled input and decodes a full BRDF.\n"
+        );
+        s.push_str(&self.table());
+        let _ = writeln!(s, "\n![Fig. 2 robustness](robustness.png)\n");
+        if let Some(m) = fig2_material {
+            let _ = writeln!(s, "![Fig. 2 slices of {m}](fig2_slices.png)\n");
+        }
+        let _ = writeln!(s, "Robustness evaluation: {:.1} s.\n", self.seconds);
+        s
+    }
+
+    /// Writes `robustness.csv` (every record) and `robustness.{png,svg}` into `dir`.
+    pub fn write(&self, dir: &Path) -> anyhow::Result<()> {
+        let mut csv = String::from("input,method,k,fold,material,mapped_mse\n");
+        for r in &self.records {
+            let _ = writeln!(
+                csv,
+                "1/{},{},{},{},{},{:e}",
+                r.every,
+                csv_field(&r.method),
+                r.k.map(|k| k.to_string()).unwrap_or_default(),
+                r.fold,
+                csv_field(&r.material),
+                r.mapped_mse
+            );
+        }
+        write_atomic_file(&dir.join("robustness.csv"), csv.as_bytes())?;
+        let columns = Self::columns();
+        let series = self
+            .rows()
+            .into_iter()
+            .map(|(label, method, k)| Series {
+                label,
+                points: columns
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(x, &every)| self.mean(every, method, k).map(|v| (x as f64, v)))
+                    .collect(),
+            })
+            .collect();
+        let chart = LineChart {
+            title: "Reconstruction from a fraction of the phi_d slices (Fig. 2)".into(),
+            x_label: "input".into(),
+            y_label: Measure::MappedMse.label().into(),
+            log_y: true,
+            series,
+            categories: Some(columns.iter().map(|&n| fraction_label(n)).collect()),
+            rotate_categories: false,
+            legend_left: true,
+            size: (800, 500),
+        };
+        write_chart(&chart, &dir.join("robustness"))?;
+        Ok(())
+    }
+}
+
+/// A CSV field, quoted when it holds a comma, a quote or a line break.
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
