@@ -157,7 +157,12 @@ fn bench_render_prints_its_numbers() {
     );
     assert!(out.status.success(), "{}", util::stderr(&out));
     let text = util::stdout(&out);
-    for needle in ["MERL lookups (renderer", "images/s", "tabulated / analytic"] {
+    for needle in [
+        "MERL lookups at random direction pairs (renderer",
+        "images/s",
+        "M lookups/s in the render",
+        "tabulated / analytic",
+    ] {
         assert!(text.contains(needle), "{needle}: {text}");
     }
 }

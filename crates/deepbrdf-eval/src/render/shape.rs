@@ -143,7 +143,7 @@ impl Shape {
     }
 
     /// The first intersection of `ray` (unit direction) beyond `t_min`.
-    #[inline]
+    #[inline(always)]
     pub fn intersect(&self, ray: &Ray, t_min: f64) -> Option<Hit> {
         let (o, d) = (ray.origin, ray.dir);
         match *self {
@@ -206,6 +206,7 @@ impl Shape {
     }
 }
 
+#[inline(never)]
 fn cylinder_hit(ray: &Ray, radius: f64, half_height: f64, t_min: f64) -> Option<Hit> {
     let (o, d) = (ray.origin, ray.dir);
     let mut best: Option<Hit> = None;
@@ -273,6 +274,7 @@ fn cubic_roots(a: f64, b: f64, c: f64) -> ([f64; 3], usize) {
 /// along the ray. The real roots of the cubic `f'(t)` split the ray's span inside the bounding
 /// sphere into pieces where `f` is monotone, each holding at most one root: the first piece whose
 /// ends differ in sign holds the first hit, refined by bisection.
+#[inline(never)]
 fn torus_hit(ray: &Ray, major: f64, minor: f64, t_min: f64) -> Option<Hit> {
     let (o, d) = (ray.origin, ray.dir);
     let bound = major + minor;

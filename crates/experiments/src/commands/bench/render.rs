@@ -6,11 +6,13 @@ use crate::data_args::CacheArg;
 use anyhow::Context;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::{Progress, Silent};
-use deepbrdf_eval::render::brdf::{sample_cosine_hemisphere, InterleavedTable};
+use deepbrdf_eval::render::brdf::{sample_cosine_hemisphere, InterleavedTable, Rgb};
+use deepbrdf_eval::render::geometry::Vec3;
 use deepbrdf_eval::render::{render, Brdf, MerlBrdf, MerlLookup, RenderSettings, SceneConfig, Sum};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::hint::black_box;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 #[derive(Debug, clap::Args)]
@@ -32,6 +34,27 @@ pub struct Args {
     pub lookups: u32,
     #[command(flatten)]
     pub cache: CacheArg,
+}
+
+/// A BRDF that counts its evaluations (for lookups per second during a render).
+struct Counting<'a> {
+    inner: &'a dyn Brdf,
+    evals: AtomicU64,
+}
+
+impl Brdf for Counting<'_> {
+    fn eval(&self, wi: Vec3, wo: Vec3) -> Rgb {
+        if wi.z > 0.0 && wo.z > 0.0 {
+            self.evals.fetch_add(1, Ordering::Relaxed);
+        }
+        self.inner.eval(wi, wo)
+    }
+    fn sample(&self, wo: Vec3, u: [f64; 2]) -> Option<Vec3> {
+        self.inner.sample(wo, u)
+    }
+    fn pdf(&self, wi: Vec3, wo: Vec3) -> f64 {
+        self.inner.pdf(wi, wo)
+    }
 }
 
 /// CPU time (user + system) of this process so far, in seconds, from `/proc/self/stat`
@@ -93,7 +116,7 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         }
         let s = start.elapsed().as_secs_f64();
         println!(
-            "MERL lookups ({label}; 1 thread): {:.1} M/s ({:.0} ns each; checksum {sum:.3e})",
+            "MERL lookups at random direction pairs ({label}; 1 thread): {:.1} M/s ({:.0} ns each; checksum {sum:.3e})",
             pairs.len() as f64 / s / 1e6,
             s / pairs.len() as f64 * 1e9
         );
@@ -124,6 +147,18 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
             t.cpu.map_or("n/a".to_string(), |c| format!("{c:.2} s")),
         );
         results.push(t.median);
+        if label.starts_with("tabulated") {
+            // Lookups made by one render (counted in an extra, untimed render: same seed, same
+            // samples), over the timed renders' median.
+            let counting = Counting { inner: brdf, evals: AtomicU64::new(0) };
+            render(&scene, &counting, &settings, &Silent)?;
+            let n = counting.evals.load(Ordering::Relaxed) as f64;
+            println!(
+                "  {:.2} M MERL lookups per image: {:.1} M lookups/s in the render ({threads} threads)",
+                n / 1e6,
+                n / t.median / 1e6
+            );
+        }
     }
     println!(
         "tabulated / analytic time in this run: {:.2} (interpolated), {:.2} (nearest); target: 256x256 at 64 spp < 0.5 s on 2 threads",
