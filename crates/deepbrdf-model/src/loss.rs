@@ -22,9 +22,46 @@ pub fn masked_mse<const D: usize>(
     (diff.clone() * diff).sum() / valid // [1]
 }
 
+/// Eq. (4), L2, for a network predicting deviations from a fixed offset mu: with the output
+/// `deviation + mu`, `((output - x) * mask)^2 = (deviation * mask - (x - mu) * mask)^2`, so the
+/// offset never enters the graph. `centred_target` is `(x - mu) * mask`; `valid` counts the
+/// valid values (the sum of `mask`, known before the batch is built).
+///
+/// # Shapes
+/// - deviation, centred_target, mask: `[batch, 540, 90, 90]`
+/// - output: `[1]`
+pub fn masked_mse_centred(
+    deviation: Tensor<4>,
+    centred_target: Tensor<4>,
+    mask: Tensor<4>,
+    valid: f64,
+) -> Tensor<1> {
+    let diff = deviation * mask - centred_target; // [batch, 540, 90, 90]
+    (diff.clone() * diff).sum().div_scalar(valid.max(1.0)) // [1]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use burn::tensor::Distribution;
+
+    #[test]
+    fn the_centred_form_equals_the_plain_one() {
+        let device = Device::default();
+        let shape = [2, 3, 4, 5];
+        let x = Tensor::<4>::random(shape, Distribution::Uniform(0.0, 2.0), &device);
+        let mu = Tensor::<4>::random(shape, Distribution::Uniform(0.0, 1.0), &device);
+        let dev = Tensor::<4>::random(shape, Distribution::Uniform(-1.0, 1.0), &device);
+        let mask = Tensor::<4>::random(shape, Distribution::Uniform(0.0, 1.0), &device)
+            .greater_elem(0.3)
+            .float();
+        let valid: f32 = mask.clone().sum().into_scalar();
+        let plain: f32 =
+            masked_mse(dev.clone() + mu.clone(), x.clone(), mask.clone()).into_scalar();
+        let centred: f32 =
+            masked_mse_centred(dev, (x - mu) * mask.clone(), mask, f64::from(valid)).into_scalar();
+        assert!((plain - centred).abs() <= 1e-5 * plain.abs(), "{plain} vs {centred}");
+    }
 
     #[test]
     fn invalid_cells_do_not_count() {

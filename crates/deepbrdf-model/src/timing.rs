@@ -5,17 +5,20 @@
 
 use std::time::Instant;
 
-use burn::optim::{AdamConfig, GradientsParams};
+use burn::optim::AdamConfig;
 use burn::prelude::*;
-use burn::tensor::{Distribution, TensorData};
+use burn::tensor::TensorData;
 use deepbrdf_data::layout::{from_layout, mask_layout};
 use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::merl::VALUES;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 
-use crate::autoencoder::{AutoencoderConfig, INPUT_CHANNELS, INPUT_SIDE};
+use crate::autoencoder::AutoencoderConfig;
 use crate::codec::grid_mask;
 use crate::error::{ModelError, Result};
-use crate::loss::masked_mse;
+use crate::train::gradients;
+use crate::training_set::TrainingSet;
 
 /// Median and all timings of repeated runs, in seconds.
 #[derive(Debug, Clone)]
@@ -36,33 +39,34 @@ impl Timing {
     }
 }
 
-/// Times `steps` training steps (after one warm-up step) on batches of `batch` BRDFs.
+/// Times `steps` training steps (after one warm-up step) on batches of `batch` BRDFs, exactly
+/// as training runs them: batch preparation on the CPU, forward, eq. (4) loss, backward, Adam.
 pub fn training_steps(
     config: &AutoencoderConfig,
     batch: usize,
+    threads: usize,
     steps: usize,
     device: &Device,
 ) -> Result<Timing> {
-    if batch == 0 || steps == 0 {
-        return Err(ModelError::Invalid("need at least one step of one BRDF".into()));
+    if batch == 0 || steps == 0 || batch > 256 {
+        return Err(ModelError::Invalid("need 1 to 256 BRDFs and at least one step".into()));
     }
     let device = device.clone().autodiff();
     device.seed(0);
+    let set = synthetic_set(batch)?;
     let mut model = config.init(&device)?;
+    if config.mean_offset {
+        model = model.with_offset(&set.mean())?;
+    }
+    let offset = model.offset();
     let mut optim = AdamConfig::new().init();
-    let shape = [batch, INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE];
-    let mask_one = mask_layout(&grid_mask());
-    let mask: Vec<f32> = (0..batch).flat_map(|_| mask_one.iter().copied()).collect();
-    let mask = Tensor::<4>::from_data(TensorData::new(mask, shape), &device);
-    let input = Tensor::<4>::random(shape, Distribution::Uniform(0.0, 2.0), &device) * mask.clone();
+    let indices: Vec<usize> = (0..batch).collect();
     let mut runs = Vec::with_capacity(steps);
     for step in 0..=steps {
         let start = Instant::now();
-        let output = model.forward(input.clone(), mask.clone());
-        let loss = masked_mse(output, input.clone(), mask.clone());
-        let value: f32 = loss.clone().into_scalar();
-        let grads = GradientsParams::from_grads(loss.backward(), &model);
-        model = optim.step(1e-5, model, grads);
+        let (value, grads) =
+            gradients(&model, &set, &indices, None, offset.as_deref(), threads, &device);
+        model = optim.step_multi(1e-5, model, grads);
         device.sync().map_err(|e| ModelError::Invalid(format!("device error: {e:?}")))?;
         if !value.is_finite() {
             return Err(ModelError::Invalid("the benchmark's loss is not finite".into()));
@@ -72,6 +76,16 @@ pub fn training_steps(
         }
     }
     Ok(Timing { runs })
+}
+
+/// `n` BRDFs of seeded random mapped values on the MERL grid's mask.
+fn synthetic_set(n: usize) -> Result<TrainingSet> {
+    let mask = mask_layout(&grid_mask());
+    let mut rng = ChaCha8Rng::seed_from_u64(0);
+    let inputs =
+        (0..n).map(|_| mask.iter().map(|&m| m * rng.random_range(0.0..2.0f32)).collect()).collect();
+    let names = (0..n).map(|i| format!("random-{i}")).collect();
+    TrainingSet::from_layouts("random", names, inputs, vec![mask; n])
 }
 
 /// Times decoding one latent vector into a full MERL table (network, inverse layout, inverse

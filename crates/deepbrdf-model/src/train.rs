@@ -11,7 +11,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use burn::optim::{AdamConfig, GradientsParams};
+use burn::optim::{AdamConfig, GradientsParams, MultiGradientsParams};
 use burn::prelude::*;
 use burn::store::ModuleRecord;
 use burn::tensor::{Bytes, TensorData};
@@ -20,6 +20,7 @@ use deepbrdf_data::Progress;
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::atomic::write_atomic;
@@ -28,7 +29,7 @@ use crate::autoencoder::{
 };
 use crate::container::Container;
 use crate::error::ModelError;
-use crate::loss::masked_mse;
+use crate::loss::masked_mse_centred;
 use crate::training_set::TrainingSet;
 
 /// File name of the checkpoint inside a training directory.
@@ -66,6 +67,10 @@ pub struct TrainConfig {
     /// once this many seconds have passed since the last one.
     #[config(default = 60.0)]
     pub checkpoint_seconds: f64,
+    /// Each batch is split into this many shards computed in parallel on CPU backends (1 on a
+    /// GPU). Results depend on it (summation order), so it is part of the configuration.
+    #[config(default = 1)]
+    pub threads: usize,
     /// Slice-dropout augmentation (§3.2, Fig. 2); none in the paper's training.
     #[config(default = "None")]
     pub slice_dropout: Option<SliceDropoutConfig>,
@@ -116,6 +121,7 @@ impl TrainConfig {
             .with_final_lr_factor(0.05)
             .with_epochs(30)
             .with_batch_size(8)
+            .with_threads(2)
     }
 
     /// Checks the settings once.
@@ -127,6 +133,9 @@ impl TrainConfig {
                 "learning rate {} with final factor {} (need lr > 0 and 0 < factor <= 1)",
                 self.learning_rate, self.final_lr_factor
             )));
+        }
+        if self.threads == 0 || self.threads > 64 {
+            return Err(ModelError::Invalid(format!("{} threads (1 to 64)", self.threads)));
         }
         if self.epochs == 0 || self.batch_size == 0 || self.batch_size > 4096 {
             return Err(ModelError::Invalid(format!(
@@ -275,6 +284,8 @@ fn run(
         };
         (model, config.optimizer.init(), state)
     };
+    // The fixed offset, for centring batches on the CPU (see `Batch`).
+    let offset = model.offset();
     let pretty = serde_json::to_string_pretty(&config_json).unwrap_or_default();
     write_atomic(&out_dir.join(CONFIG_FILE), &[pretty.as_bytes(), b"\n"])?;
 
@@ -304,10 +315,15 @@ fn run(
                 seed: config.seed,
                 epoch: state.epoch,
             });
-            let (input, target, mask) = batch_tensors(data, indices, augment.as_ref(), &autodiff);
-            let output = model.forward(input, mask.clone());
-            let loss = masked_mse(output, target, mask);
-            let value: f32 = loss.clone().into_scalar();
+            let (value, grads) = gradients(
+                &model,
+                data,
+                indices,
+                augment.as_ref(),
+                offset.as_deref(),
+                config.threads,
+                &autodiff,
+            );
             if !value.is_finite() {
                 progress.finish();
                 let kept = if checkpoint.exists() {
@@ -330,8 +346,7 @@ fn run(
             }
             lr =
                 config.learning_rate_at(state.epoch * batches_per_epoch + state.batch, total_steps);
-            let grads = GradientsParams::from_grads(loss.backward(), &model);
-            model = optim.step(lr, model, grads);
+            model = optim.step_multi(lr, model, grads);
             if kill_after == Some((state.epoch, state.batch)) {
                 return Err(ModelError::Invalid("killed (test)".into()));
             }
@@ -394,20 +409,19 @@ pub fn evaluate(
 ) -> crate::error::Result<Vec<f64>> {
     let model = model.valid();
     let device = model.devices().into_iter().next().unwrap_or_default().without_autodiff();
+    let offset = model.offset();
     let mut errors = Vec::with_capacity(data.len());
     let indices: Vec<usize> = (0..data.len()).collect();
     progress.start(data.len() as u64, "evaluating");
     for chunk in indices.chunks(batch_size.max(1)) {
-        let (input, _, mask) = batch_tensors(data, chunk, None, &device);
-        let output = model.forward(input.clone(), mask.clone());
+        let b = batch_tensors(data, chunk, None, offset.as_deref(), &device);
+        let deviation = model.decode_deviation(model.encode_centred(b.input));
         let batch = chunk.len();
-        let diff = (output - input) * mask.clone();
+        let diff = deviation * b.mask - b.target; // [batch, 540, 90, 90]
         let sq = (diff.clone() * diff).reshape([batch, INPUT_VALUES]).sum_dim(1); // [batch, 1]
-        let valid = mask.reshape([batch, INPUT_VALUES]).sum_dim(1); // [batch, 1]
         let sq: Vec<f32> = sq.into_data().try_into_vec().map_err(tensor_error)?;
-        let valid: Vec<f32> = valid.into_data().try_into_vec().map_err(tensor_error)?;
-        for (s, v) in sq.iter().zip(&valid) {
-            errors.push(f64::from(*s) / f64::from(v.max(1.0)));
+        for (s, v) in sq.iter().zip(&b.valid) {
+            errors.push(f64::from(*s) / v.max(1.0));
         }
         progress.advance(batch as u64);
     }
@@ -430,7 +444,7 @@ pub fn epoch_order(seed: u64, epoch: usize, n: usize) -> Vec<usize> {
 }
 
 /// Slice dropout applied to one batch.
-struct Augment<'a> {
+pub(crate) struct Augment<'a> {
     probability: f64,
     selections: &'a [SliceSelection],
     seed: u64,
@@ -451,42 +465,126 @@ impl Augment<'_> {
     }
 }
 
-/// Stacks the layouts and masks of `indices` into `[batch, 540, 90, 90]` tensors: the input,
-/// the target (the input itself unless slice dropout changed it) and the mask.
-fn batch_tensors(
+/// One training batch, prepared on the CPU: inputs and targets centred on the fixed offset
+/// and masked, `(x - mu) * mask` (just `x * mask` without an offset), as
+/// [`masked_mse_centred`] expects.
+pub(crate) struct Batch {
+    /// `[batch, 540, 90, 90]`: the network's input (with slice dropout, the filled one).
+    input: Tensor<4>,
+    /// `[batch, 540, 90, 90]`: the centred, masked target.
+    target: Tensor<4>,
+    /// `[batch, 540, 90, 90]`
+    mask: Tensor<4>,
+    /// Valid values of each BRDF.
+    valid: Vec<f64>,
+}
+
+/// The eq. (4) loss of a batch, its squared error divided by `valid` (the valid values of the
+/// whole batch when this is a shard of it): the forward step training and benchmarks share.
+pub(crate) fn batch_loss(model: &Autoencoder, batch: Batch, valid: f64) -> Tensor<1> {
+    let deviation = model.decode_deviation(model.encode_centred(batch.input)); // [batch, 540, 90, 90]
+    masked_mse_centred(deviation, batch.target, batch.mask, valid) // [1]
+}
+
+/// The loss and gradients of the batch `indices`, computed in `threads` shards in parallel
+/// (Burn's CPU backends as built here run each operation on one core; shards put both cores
+/// to work). Each shard works on its own fork of the model (its own autodiff graph); the
+/// optimizer sums the shards' gradients, each normalised by the whole batch's valid values,
+/// so the step is that of the whole batch. Deterministic for a given `threads`.
+pub(crate) fn gradients(
+    model: &Autoencoder,
     data: &TrainingSet,
     indices: &[usize],
     augment: Option<&Augment>,
+    offset: Option<&[f32]>,
+    threads: usize,
     device: &Device,
-) -> (Tensor<4>, Tensor<4>, Tensor<4>) {
-    let shape = [indices.len(), INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE];
-    let mut input = Vec::with_capacity(indices.len() * INPUT_VALUES);
-    let mut mask = Vec::with_capacity(indices.len() * INPUT_VALUES);
-    let mut augmented = false;
-    for &i in indices {
-        let start = input.len();
-        input.extend_from_slice(data.input(i));
-        mask.extend_from_slice(data.mask(i));
-        if let Some(kept) = augment.and_then(|a| a.kept(i)) {
-            let slot = &mut input[start..];
-            fill_missing_layout(slot, &kept);
-            for (v, m) in slot.iter_mut().zip(data.mask(i)) {
-                *v *= m;
+) -> (f32, MultiGradientsParams) {
+    let valid: f64 = indices.iter().map(|&i| data.valid_values(i)).sum();
+    let shard = |indices: &[usize], forked: bool| {
+        let model = if forked { model.clone().fork(device) } else { model.clone() };
+        let batch = batch_tensors(data, indices, augment, offset, device);
+        let loss = batch_loss(&model, batch, valid);
+        let value: f32 = loss.clone().into_scalar();
+        (value, GradientsParams::from_grads(loss.backward(), &model))
+    };
+    let shards: Vec<&[usize]> = indices.chunks(indices.len().div_ceil(threads.max(1))).collect();
+    let results: Vec<(f32, GradientsParams)> = if shards.len() == 1 {
+        vec![shard(shards[0], false)]
+    } else {
+        std::thread::scope(|scope| {
+            let handles: Vec<_> =
+                shards.iter().map(|&s| scope.spawn(move || shard(s, true))).collect();
+            handles
+                .into_iter()
+                .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+                .collect()
+        })
+    };
+    let mut total = 0f32;
+    let mut grads = MultiGradientsParams::default();
+    for (value, g) in results {
+        total += value;
+        grads.grads.push((g, device.clone()));
+    }
+    (total, grads)
+}
+
+/// Writes `(x - offset) * mask` into `out`, in parallel.
+fn centre(out: &mut [f32], x: &[f32], mask: &[f32], offset: Option<&[f32]>) {
+    const CHUNK: usize = 1 << 16;
+    out.par_chunks_mut(CHUNK).enumerate().for_each(|(c, o)| {
+        let range = c * CHUNK..c * CHUNK + o.len();
+        let (x, m) = (&x[range.clone()], &mask[range.clone()]);
+        match offset {
+            Some(mu) => {
+                for (((o, &x), &m), &mu) in o.iter_mut().zip(x).zip(m).zip(&mu[range]) {
+                    *o = (x - mu) * m;
+                }
             }
-            augmented = true;
+            None => {
+                for ((o, &x), &m) in o.iter_mut().zip(x).zip(m) {
+                    *o = x * m;
+                }
+            }
+        }
+    });
+}
+
+/// Stacks BRDFs `indices` of `data` into a [`Batch`] on `device`.
+pub(crate) fn batch_tensors(
+    data: &TrainingSet,
+    indices: &[usize],
+    augment: Option<&Augment>,
+    offset: Option<&[f32]>,
+    device: &Device,
+) -> Batch {
+    let shape = [indices.len(), INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE];
+    let len = indices.len() * INPUT_VALUES;
+    let mut target = vec![0f32; len];
+    let mut mask = vec![0f32; len];
+    let mut input: Option<Vec<f32>> = None;
+    let mut valid = Vec::with_capacity(indices.len());
+    for (slot, &i) in indices.iter().enumerate() {
+        let range = slot * INPUT_VALUES..(slot + 1) * INPUT_VALUES;
+        centre(&mut target[range.clone()], data.input(i), data.mask(i), offset);
+        mask[range.clone()].copy_from_slice(data.mask(i));
+        valid.push(data.mask(i).iter().map(|&m| f64::from(m)).sum());
+        if let Some(kept) = augment.and_then(|a| a.kept(i)) {
+            let input = input.get_or_insert_with(|| target.clone());
+            let mut filled = data.input(i).to_vec();
+            fill_missing_layout(&mut filled, &kept);
+            centre(&mut input[range], &filled, data.mask(i), offset);
+        } else if let Some(input) = input.as_mut() {
+            input[range.clone()].copy_from_slice(&target[range]);
         }
     }
-    let input = Tensor::from_data(TensorData::new(input, shape), device);
-    let target = if augmented {
-        let mut target = Vec::with_capacity(indices.len() * INPUT_VALUES);
-        for &i in indices {
-            target.extend_from_slice(data.input(i));
-        }
-        Tensor::from_data(TensorData::new(target, shape), device)
-    } else {
-        input.clone()
+    let target = Tensor::from_data(TensorData::new(target, shape), device);
+    let input = match input {
+        Some(input) => Tensor::from_data(TensorData::new(input, shape), device),
+        None => target.clone(),
     };
-    (input, target, Tensor::from_data(TensorData::new(mask, shape), device))
+    Batch { input, target, mask: Tensor::from_data(TensorData::new(mask, shape), device), valid }
 }
 
 fn save_checkpoint(
@@ -665,7 +763,8 @@ mod tests {
     #[test]
     fn a_killed_run_resumes_to_the_same_result() {
         let set = tiny_set(3); // 2 batches per epoch, the last one short
-        let config = tiny_config(true).with_epochs(2).with_final_lr_factor(0.1);
+                               // Two shards per batch: the parallel path is as reproducible as the serial one.
+        let config = tiny_config(true).with_epochs(2).with_final_lr_factor(0.1).with_threads(2);
         let device = DeviceKind::default_kind().unwrap().device().unwrap();
         let straight_dir = tempfile::tempdir().unwrap();
         let straight = train(&config, &set, straight_dir.path(), false, &Silent, &device).unwrap();
@@ -757,9 +856,9 @@ mod tests {
         let device = DeviceKind::default_kind().unwrap().device().unwrap();
         let selections = [SliceSelection::Every(9)];
         let augment = Augment { probability: 1.0, selections: &selections, seed: 3, epoch: 0 };
-        let (input, target, _) = batch_tensors(&set, &[1], Some(&augment), &device);
-        let input: Vec<f32> = input.into_data().try_into_vec().unwrap();
-        let target: Vec<f32> = target.into_data().try_into_vec().unwrap();
+        let b = batch_tensors(&set, &[1], Some(&augment), None, &device);
+        let input: Vec<f32> = b.input.into_data().try_into_vec().unwrap();
+        let target: Vec<f32> = b.target.into_data().try_into_vec().unwrap();
         assert_eq!(target, set.input(1));
         // Slice 1 (channels 3..6) is filled from slice 0 (every 9th slice from 0 is kept).
         let slice = 3 * INPUT_SIDE * INPUT_SIDE;

@@ -22,6 +22,7 @@ pub struct TrainingSet {
     names: Vec<String>,
     inputs: Vec<Vec<f32>>,
     masks: Vec<Arc<Vec<f32>>>,
+    valid: Vec<f64>,
 }
 
 impl TrainingSet {
@@ -86,7 +87,14 @@ impl TrainingSet {
                 )));
             }
         }
-        Ok(Self { label, names, inputs, masks })
+        let mut valid = Vec::with_capacity(masks.len());
+        for (i, mask) in masks.iter().enumerate() {
+            match (0..i).find(|&j| Arc::ptr_eq(&masks[j], mask)) {
+                Some(j) => valid.push(valid[j]),
+                None => valid.push(mask.iter().map(|&m| f64::from(m)).sum()),
+            }
+        }
+        Ok(Self { label, names, inputs, masks, valid })
     }
 
     /// Maps `tables` with eq. (1) relative to `reference` and reorders them into the §3.2
@@ -153,6 +161,11 @@ impl TrainingSet {
     /// The layout mask of BRDF `i`.
     pub fn mask(&self, i: usize) -> &[f32] {
         &self.masks[i]
+    }
+
+    /// The number of valid values of BRDF `i` (the sum of its mask).
+    pub fn valid_values(&self, i: usize) -> f64 {
+        self.valid[i]
     }
 
     /// Per-value mean over the BRDFs valid there (0 where none is): the offset of the CPU

@@ -6,12 +6,13 @@
 //! (same configuration, data label and materials) is loaded, not retrained.
 
 use crate::mapped_input::InputCache;
+use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::harness::{Codec, Method, TrainingSet};
 use deepbrdf_eval::{EvalError, Result};
 use deepbrdf_model::artifact::MODEL_DIR;
 use deepbrdf_model::burn::tensor::Device;
-use deepbrdf_model::{DeepBrdf, TrainConfig};
+use deepbrdf_model::{DeepBrdf, ModelArtifact, TrainConfig, TrainingSet as MappedSet};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
@@ -92,16 +93,21 @@ impl DeepMethod {
         models.iter().find(|(f, kk, _)| *f == fold && *kk == k).map(|(_, _, m)| m.clone())
     }
 
-    /// Loads or trains the model of (fold, k) on `tables`.
+    /// Loads or trains the model of (fold, k) on `train`.
+    ///
+    /// Training does what `deepbrdf_model::fit` does, but with the fold's eq. (1) reference
+    /// from the harness and one mapped training set (`set`, built on first use) for all k of
+    /// the fold, instead of a median and a mapping per k.
     fn fit_in(
         &self,
         fold: usize,
-        tables: &[&MerlTable],
-        names: &[String],
+        train: &TrainingSet<'_>,
         k: usize,
         cache: &Arc<InputCache>,
+        set: &mut Option<MappedSet>,
         progress: &dyn Progress,
     ) -> Result<Box<dyn Codec>> {
+        let names = train.names;
         let started = std::time::Instant::now();
         let config = (self.config_for)(k);
         if config.model.latent != k {
@@ -114,18 +120,27 @@ impl DeepMethod {
         let (model, origin) = match self.load_finished(&dir, &config, names)? {
             Some(model) => (model, FitOrigin::Loaded),
             None => {
-                progress.status(&format!("fold {fold}"));
-                let model = deepbrdf_model::fit(
-                    &config,
-                    &self.label,
-                    names,
-                    tables,
-                    &dir,
-                    true,
-                    progress,
-                    &self.device,
-                )
-                .map_err(|e| model_error(&dir, e))?;
+                let mapped = match set {
+                    Some(mapped) => mapped,
+                    None => set.insert(
+                        MappedSet::from_tables(&self.label, names, train.tables, train.reference)
+                            .map_err(|e| model_error(&dir, e))?,
+                    ),
+                };
+                let model =
+                    deepbrdf_model::train(&config, mapped, &dir, true, progress, &self.device)
+                        .and_then(|trained| {
+                            let artifact = ModelArtifact::from_trained(
+                                &trained,
+                                train.reference.clone(),
+                                &self.label,
+                                names,
+                                &self.device,
+                            )?;
+                            artifact.save(&dir.join(MODEL_DIR))?;
+                            DeepBrdf::from_artifact(artifact, &self.device)
+                        })
+                        .map_err(|e| model_error(&dir, e))?;
                 (model, FitOrigin::Trained)
             }
         };
@@ -238,7 +253,9 @@ impl Method for DeepMethod {
         progress: &dyn Progress,
     ) -> Result<Box<dyn Codec>> {
         let fold = self.next_fold.load(Ordering::SeqCst);
-        self.fit_in(fold, train, names, k, &Arc::default(), progress)
+        let reference = MedianReference::from_tables(train)?;
+        let set = TrainingSet { tables: train, names, reference: &reference };
+        self.fit_in(fold, &set, k, &Arc::default(), &mut None, progress)
     }
 
     fn fit_fold(
@@ -249,9 +266,10 @@ impl Method for DeepMethod {
     ) -> Result<Vec<Box<dyn Codec>>> {
         let fold = self.next_fold.load(Ordering::SeqCst);
         let cache = Arc::new(InputCache::default());
+        let mut set = None;
         let codecs = ks
             .iter()
-            .map(|&k| self.fit_in(fold, train.tables, train.names, k, &cache, progress))
+            .map(|&k| self.fit_in(fold, train, k, &cache, &mut set, progress))
             .collect::<Result<Vec<_>>>()?;
         self.next_fold.store(fold + 1, Ordering::SeqCst);
         Ok(codecs)

@@ -3,8 +3,9 @@
 //! <= 0.15 s on 2 cores; the paper reports 0.3 s on a GPU, IPCA 0.15 s). All measured in the
 //! same run, on the `--device` backend.
 use deepbrdf_data::Progress;
+use deepbrdf_model::burn::config::Config;
 use deepbrdf_model::timing;
-use deepbrdf_model::Preset;
+use deepbrdf_model::{Preset, TrainConfig};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -23,6 +24,9 @@ pub struct Args {
     /// Timed decodes per preset (after one warm-up).
     #[arg(long, default_value_t = 5)]
     pub decodes: usize,
+    /// Also time the network of this training configuration (JSON, as `train` saves it).
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<std::path::PathBuf>,
 }
 
 fn parse_preset(s: &str) -> Result<Preset, String> {
@@ -32,34 +36,43 @@ fn parse_preset(s: &str) -> Result<Preset, String> {
 pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     let kind = crate::device_arg::kind()?;
     let device = crate::device_arg::device()?;
-    let presets: Vec<Preset> = match args.preset {
-        Some(p) => vec![p],
-        None => Preset::ALL.to_vec(),
+    let mut runs: Vec<(String, TrainConfig)> = match (args.preset, &args.config) {
+        (Some(p), _) => vec![(p.name().to_string(), p.train_config(args.k))],
+        (None, Some(_)) => Vec::new(),
+        (None, None) => {
+            Preset::ALL.iter().map(|p| (p.name().to_string(), p.train_config(args.k))).collect()
+        }
     };
+    if let Some(path) = &args.config {
+        let config = TrainConfig::load(path).map_err(|e| {
+            anyhow::anyhow!("{}: not a training configuration: {e}", path.display())
+        })?;
+        runs.push(("config".to_string(), config));
+    }
     println!("device {kind}, k = {}", args.k);
     println!(
         "{:7} {:>6} {:>16} {:>16} {:>14} {:>14}",
         "preset", "batch", "train s/step", "train s/sample", "decode net s", "decode all s"
     );
     let mut per_sample = Vec::new();
-    for preset in presets {
-        let config = preset.train_config(args.k);
+    for (name, config) in runs {
         let batch = args.batch.unwrap_or(config.batch_size);
-        let train = timing::training_steps(&config.model, batch, args.steps, &device)?;
+        let train =
+            timing::training_steps(&config.model, batch, config.threads, args.steps, &device)?;
         let (net, all) = timing::decode(&config.model, args.decodes, &device)?;
         let step = train.median();
         println!(
             "{:7} {:>6} {:>16.3} {:>16.4} {:>14.4} {:>14.4}",
-            preset.name(),
+            name,
             batch,
             step,
             step / batch as f64,
             net.median(),
             all.median()
         );
-        per_sample.push((preset, step / batch as f64));
+        per_sample.push((name, step / batch as f64));
     }
-    if let [(a, ta), (b, tb)] = per_sample[..] {
+    if let [(a, ta), (b, tb)] = &per_sample[..] {
         println!("training cost per sample: {b} / {a} = {:.1}x", tb / ta);
     }
     println!("(medians; decode = network + inverse layout + inverse eq. (1) to a full MERL table)");
