@@ -167,7 +167,6 @@ mod tests {
 
     fn codec() -> DeepBrdf {
         let device = DeviceKind::default_kind().unwrap().device().unwrap();
-        device.seed(3);
         let config = AutoencoderConfig::new()
             .with_latent(3)
             .with_projection(Some(1))
@@ -176,7 +175,7 @@ mod tests {
             .with_decoder_channels([1, 1])
             .with_mean_offset(true);
         let offset: Vec<f32> = (0..INPUT_VALUES).map(|i| 0.5 + 0.1 * ((i % 11) as f32)).collect();
-        let model = config.init(&device).unwrap().with_offset(&offset).unwrap();
+        let model = config.init_seeded(3, &device).unwrap().with_offset(&offset).unwrap();
         let provenance = Provenance {
             data_label: "synthetic".into(),
             materials: vec![],

@@ -52,9 +52,8 @@ pub fn training_steps(
         return Err(ModelError::Invalid("need 1 to 256 BRDFs and at least one step".into()));
     }
     let device = device.clone().autodiff();
-    device.seed(0);
     let set = synthetic_set(batch)?;
-    let mut model = config.init(&device)?;
+    let mut model = config.init_seeded(0, &device)?;
     if config.mean_offset {
         model = model.with_offset(&set.mean())?;
     }
@@ -97,8 +96,7 @@ pub fn decode(
     device: &Device,
 ) -> Result<(Timing, Timing)> {
     let device = device.clone().without_autodiff();
-    device.seed(0);
-    let model = config.init(&device)?;
+    let model = config.init_seeded(0, &device)?;
     let reference = MedianReference::from_values(vec![0.05; VALUES])?;
     let mask = grid_mask();
     let mut network = Vec::new();

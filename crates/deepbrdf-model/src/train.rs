@@ -265,9 +265,7 @@ fn run(
         }
         load_checkpoint(&checkpoint, config, &config_json, &fingerprint, &autodiff)?
     } else {
-        device.seed(config.seed);
-        autodiff.seed(config.seed);
-        let mut model = config.model.init(&autodiff)?;
+        let mut model = config.model.init_seeded(config.seed, &autodiff)?;
         if config.model.mean_offset {
             model = model.with_offset(&data.mean())?;
         }
