@@ -14,6 +14,8 @@ pub mod error;
 pub mod fit;
 pub mod loss;
 pub mod preset;
+pub mod principal;
+pub mod spectral;
 pub mod timing;
 pub mod train;
 pub mod training_set;

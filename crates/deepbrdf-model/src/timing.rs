@@ -5,7 +5,6 @@
 
 use std::time::Instant;
 
-use burn::optim::AdamConfig;
 use burn::prelude::*;
 use burn::tensor::TensorData;
 use deepbrdf_data::layout::{from_layout, mask_layout};
@@ -17,7 +16,7 @@ use rand_chacha::ChaCha8Rng;
 use crate::autoencoder::AutoencoderConfig;
 use crate::codec::grid_mask;
 use crate::error::{ModelError, Result};
-use crate::train::gradients;
+use crate::train::{coefficient_gradients, gradients};
 use crate::training_set::TrainingSet;
 
 /// Median and all timings of repeated runs, in seconds.
@@ -40,7 +39,9 @@ impl Timing {
 }
 
 /// Times `steps` training steps (after one warm-up step) on batches of `batch` BRDFs, exactly
-/// as training runs them: batch preparation on the CPU, forward, eq. (4) loss, backward, Adam.
+/// as training runs them: batch preparation on the CPU, forward, eq. (4) loss, backward, Adam
+/// (for a network without convolutions, the step on spectral coordinates; the basis fit, done
+/// once per training run, is not timed).
 pub fn training_steps(
     config: &AutoencoderConfig,
     batch: usize,
@@ -58,13 +59,23 @@ pub fn training_steps(
         model = model.with_offset(&set.mean())?;
     }
     let offset = model.offset();
-    let mut optim = AdamConfig::new().init();
+    let fit = match (config.spectral_basis, &offset) {
+        (Some(size), Some(mean)) => {
+            let fit = crate::principal::fit_basis(&set, mean, size)?;
+            model = model.with_basis(&fit.basis)?;
+            Some(fit).filter(|_| config.spectral_only())
+        }
+        _ => None,
+    };
+    let mut optim = crate::train::adam().init();
     let indices: Vec<usize> = (0..batch).collect();
     let mut runs = Vec::with_capacity(steps);
     for step in 0..=steps {
         let start = Instant::now();
-        let (value, grads) =
-            gradients(&model, &set, &indices, None, offset.as_deref(), threads, &device);
+        let (value, grads) = match &fit {
+            Some(fit) => coefficient_gradients(&model, &set, fit, &indices, &device)?,
+            None => gradients(&model, &set, &indices, None, offset.as_deref(), threads, &device),
+        };
         model = optim.step_multi(1e-5, model, grads);
         device.sync().map_err(|e| ModelError::Invalid(format!("device error: {e:?}")))?;
         if !value.is_finite() {

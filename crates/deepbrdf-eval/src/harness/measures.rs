@@ -20,17 +20,30 @@ pub enum Measure {
     /// Root mean square of `(rho - rho_hat) cos(theta_i) cos(theta_o)`, linear reflectance
     /// (1/sr) weighted by the cosines as in Nielsen et al. 2015's mapping.
     CosRmse,
+    /// Image-space RelAE (§4, Fig. 4): `sum |I - I_ref| / sum |I_ref|` between renders of the
+    /// reconstruction and of the original, the preview sphere under sun and sky
+    /// ([`crate::metrics::ImageRelae`] with its default scene). Costs two renders (~0.15 s of
+    /// CPU each), so it is opt-in.
+    ImageRelae,
 }
 
 impl Measure {
     /// All measures, in table order.
-    pub const ALL: [Measure; 2] = [Measure::MappedMse, Measure::CosRmse];
+    pub const ALL: [Measure; 3] = [Measure::MappedMse, Measure::CosRmse, Measure::ImageRelae];
+    /// The measures computed on the tables alone (fast; the default).
+    pub const TABLE: [Measure; 2] = [Measure::MappedMse, Measure::CosRmse];
+
+    /// Whether the measure renders images (not computed by [`Yardstick::measure`]).
+    pub fn renders(self) -> bool {
+        self == Self::ImageRelae
+    }
 
     /// Machine name, used in CSV files and on the command line.
     pub fn name(self) -> &'static str {
         match self {
             Self::MappedMse => "mapped_mse",
             Self::CosRmse => "cos_rmse",
+            Self::ImageRelae => "image_relae",
         }
     }
 
@@ -39,6 +52,7 @@ impl Measure {
         match self {
             Self::MappedMse => "MSE in eq. (1) mapped space",
             Self::CosRmse => "cosine-weighted RMSE (1/sr)",
+            Self::ImageRelae => "image-space RelAE (sphere, sun and sky)",
         }
     }
 }
@@ -53,7 +67,7 @@ impl FromStr for Measure {
     type Err = EvalError;
     fn from_str(s: &str) -> Result<Self> {
         Self::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
-            EvalError::Invalid(format!("unknown measure '{s}' (mapped_mse, cos_rmse)"))
+            EvalError::Invalid(format!("unknown measure '{s}' (mapped_mse, cos_rmse, image_relae)"))
         })
     }
 }
@@ -125,6 +139,11 @@ impl Yardstick {
         if recon.values().len() != VALUES {
             return Err(EvalError::Invalid("reconstruction is not a full table".into()));
         }
+        if let Some(m) = measures.iter().find(|m| m.renders()) {
+            return Err(EvalError::Invalid(format!(
+                "{m} is measured on renders (metrics::ImageRelae), not on tables"
+            )));
+        }
         let n = original.cells.len();
         if n == 0 {
             return Err(EvalError::Invalid("the original table has no valid cell".into()));
@@ -163,6 +182,7 @@ impl Yardstick {
             .map(|m| match m {
                 Measure::MappedMse => mapped_sum / count,
                 Measure::CosRmse => (cos_sum / count).sqrt(),
+                Measure::ImageRelae => f64::NAN, // rejected above
             })
             .collect())
     }
@@ -186,7 +206,7 @@ mod tests {
             assert!(a.is_valid(cell));
             recon.values_mut()[CELLS + cell] = -1.0;
         }
-        let got = yardstick.measure(&original, &recon, &Measure::ALL).unwrap();
+        let got = yardstick.measure(&original, &recon, &Measure::TABLE).unwrap();
         // Independent computation: the reference's own full-table map (eq. 1), all cells.
         let (ma, mut zeroed) = (yardstick.reference().map(&a), recon.values().to_vec());
         for &cell in &lost {
@@ -209,7 +229,7 @@ mod tests {
         assert!((got[0] - mse).abs() <= 1e-9 * mse, "mapped mse {} vs {mse}", got[0]);
         assert!((got[1] - rmse).abs() <= 1e-6 * rmse, "cos rmse {} vs {rmse}", got[1]);
         // A perfect reconstruction scores 0 on every measure.
-        assert_eq!(yardstick.measure(&original, &a, &Measure::ALL).unwrap(), vec![0.0, 0.0]);
+        assert_eq!(yardstick.measure(&original, &a, &Measure::TABLE).unwrap(), vec![0.0, 0.0]);
         // Order follows the request.
         let one = yardstick.measure(&original, &recon, &[Measure::CosRmse]).unwrap();
         assert_eq!(one, vec![got[1]]);

@@ -14,6 +14,7 @@ pub use modes::{Fold, Mode};
 pub use report::{FitTiming, Record, Results};
 
 use crate::error::{EvalError, Result};
+use crate::metrics::{ImageRelae, ImageRelaeConfig};
 use deepbrdf_data::{MerlTable, Progress};
 use std::time::Instant;
 
@@ -42,6 +43,12 @@ impl HarnessConfig {
         }
         if self.measures.is_empty() {
             return Err(EvalError::Invalid("no measure selected".into()));
+        }
+        let mut measures = self.measures.clone();
+        measures.sort_unstable();
+        measures.dedup();
+        if measures.len() != self.measures.len() {
+            return Err(EvalError::Invalid(format!("repeated measure in {:?}", self.measures)));
         }
         Ok(())
     }
@@ -102,6 +109,14 @@ pub fn run(
         }
         (_, None) => train,
     };
+    // Table measures first (one pass over the cells), then the rendered one.
+    let table_measures: Vec<Measure> =
+        config.measures.iter().copied().filter(|m| !m.renders()).collect();
+    let renders = config.measures.iter().any(|m| m.renders());
+    let mut measure_order = table_measures.clone();
+    if renders {
+        measure_order.push(Measure::ImageRelae);
+    }
     let started = Instant::now();
     let folds = config.mode.folds(train.tables.len(), eval_set.tables.len(), config.seed)?;
     let mut records = Vec::new();
@@ -150,6 +165,10 @@ pub fn run(
         progress.start(steps as u64, &format!("evaluating fold {}", fold.index + 1));
         for &i in &fold.test {
             let original = yardstick.original(&eval_set.tables[i]);
+            let image = match renders {
+                true => Some(ImageRelae::new(&eval_set.tables[i], &ImageRelaeConfig::default())?),
+                false => None,
+            };
             for (method, list) in &codecs {
                 for codec in list {
                     let code = codec.encode(&eval_set.tables[i])?;
@@ -162,8 +181,11 @@ pub fn run(
                         )));
                     }
                     let recon = codec.decode(&code)?;
-                    let values = yardstick.measure(&original, &recon, &config.measures)?;
-                    for (&measure, value) in config.measures.iter().zip(values) {
+                    let mut values = yardstick.measure(&original, &recon, &table_measures)?;
+                    if let Some(image) = &image {
+                        values.push(image.measure(&recon)?);
+                    }
+                    for (&measure, value) in measure_order.iter().zip(values) {
                         records.push(Record {
                             method: method.clone(),
                             k: codec.k(),
@@ -208,6 +230,30 @@ mod tests {
     }
 
     #[test]
+    fn image_relae_is_measured_on_renders_and_vanishes_for_an_exact_reconstruction() {
+        let (names, tables) = sparse_set(4);
+        let (pca, _) = methods();
+        let config = HarnessConfig {
+            ks: vec![1, 3],
+            mode: Mode::InSample,
+            seed: 1,
+            measures: vec![Measure::ImageRelae, Measure::MappedMse],
+        };
+        let data = Materials { names: &names, tables: &tables, label: "synthetic" };
+        let results = run(&[&pca], &config, data, None, &Silent).unwrap();
+        assert_eq!(results.records.len(), 2 * 4 * 2);
+        let relae = |k: usize| results.mean("PCA", k, Measure::ImageRelae).unwrap();
+        // k = n-1 reproduces the tables, so their renders agree (same seed, same directions).
+        assert!(relae(1) > 1e-3, "{}", relae(1));
+        assert!(relae(3) < 1e-4 * relae(1).max(1.0), "{} vs {}", relae(3), relae(1));
+        // Each record carries its own measure: the mapped-space values are the table ones.
+        let mapped = results.mean("PCA", 1, Measure::MappedMse).unwrap();
+        assert!(mapped > 0.0 && (mapped - relae(1)).abs() > 1e-9);
+        let repeated = HarnessConfig { measures: vec![Measure::MappedMse; 2], ..config };
+        assert!(run(&[&pca], &repeated, data, None, &Silent).is_err());
+    }
+
+    #[test]
     fn in_sample_error_falls_with_k_and_vanishes_at_n_minus_1() {
         let (names, tables) = sparse_set(6);
         let (pca, ipca) = methods();
@@ -215,13 +261,13 @@ mod tests {
             ks: vec![1, 2, 5],
             mode: Mode::InSample,
             seed: 1,
-            measures: Measure::ALL.to_vec(),
+            measures: Measure::TABLE.to_vec(),
         };
         let data = Materials { names: &names, tables: &tables, label: "synthetic" };
         let results = run(&[&pca, &ipca], &config, data, None, &Silent).unwrap();
         assert_eq!(results.records.len(), 2 * 3 * 6 * 2);
         for method in ["PCA", "IPCA"] {
-            for m in Measure::ALL {
+            for m in Measure::TABLE {
                 let e: Vec<f64> =
                     [1, 2, 5].iter().map(|&k| results.mean(method, k, m).unwrap()).collect();
                 assert!(e[1] <= e[0] && e[2] <= e[1], "{method} {m}: {e:?}");
@@ -235,6 +281,7 @@ mod tests {
                 let bound = match m {
                     Measure::MappedMse => 1e-8,
                     Measure::CosRmse => 1e-5,
+                    Measure::ImageRelae => unreachable!("not measured here"),
                 };
                 assert!(e[2] < bound * e[0], "{method} {m}: k = n-1 gives {e:?}");
             }

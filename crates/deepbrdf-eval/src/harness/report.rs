@@ -314,7 +314,7 @@ mod tests {
         for (mi, method) in methods.iter().enumerate() {
             for &k in &ks {
                 for i in 0..n {
-                    for measure in Measure::ALL {
+                    for measure in Measure::TABLE {
                         let hardness = 1.0 + ((i * 37) % n) as f64 / n as f64 * 20.0;
                         let value = hardness * 1e-2 / (1.0 + mi as f64) / k as f64;
                         records.push(Record {
@@ -334,7 +334,7 @@ mod tests {
             seed: 3,
             ks,
             methods: methods.iter().map(|m| m.to_string()).collect(),
-            measures: Measure::ALL.to_vec(),
+            measures: Measure::TABLE.to_vec(),
             train_label: "fake (100)".into(),
             eval_label: "fake (100)".into(),
             records,

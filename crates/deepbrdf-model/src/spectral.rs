@@ -1,0 +1,150 @@
+//! The spectral path of the `cpu` preset (not in the paper): the autoencoder of §3.2 run on the
+//! coordinates of a BRDF in the K leading principal directions of the training set (eq. (1)
+//! space, centred on the training mean, see [`crate::principal`]).
+//!
+//! - encoder: `c = U (x - mu)` (K coefficients), `z = c[..k] + f(c)`
+//! - decoder: `c_hat = [z, 0] + g(z)`, `x_hat = mu + U^T c_hat`
+//!
+//! with f, g small MLPs (leaky ReLU) whose last layers start at zero, so an untrained network is
+//! the rank-k linear fit (PCA in the mapped space) and training learns the nonlinear part. With
+//! K at least the rank of the training set, U^T represents every training BRDF exactly and the
+//! loss of eq. (4) on the training set equals the squared error of the coefficients (plus a
+//! constant), which is how training computes it: a step costs microseconds instead of the
+//! convolutions' ~0.1 s per BRDF on two cores.
+
+use burn::module::Param;
+use burn::nn::{Initializer, Linear, LinearConfig};
+use burn::prelude::*;
+use burn::tensor::activation::leaky_relu;
+use burn::tensor::TensorData;
+
+use crate::autoencoder::INPUT_VALUES;
+use crate::error::ModelError;
+
+/// The fixed basis and the two coefficient-space networks.
+#[derive(Module, Debug)]
+pub struct SpectralPath {
+    /// `[K, 540 * 90 * 90]`: orthonormal rows (zero rows past the training set's rank). Fixed.
+    basis: Param<Tensor<2>>,
+    /// f: K -> hidden -> hidden -> k (empty: none).
+    encoder: Vec<Linear>,
+    /// g: k -> hidden -> hidden -> K (empty: none).
+    decoder: Vec<Linear>,
+    size: usize,
+    latent: usize,
+    negative_slope: f64,
+}
+
+impl SpectralPath {
+    /// A path of `size` directions for latent dimension `latent`, with MLPs of width `hidden`
+    /// (none without); hidden layers from `init`, the last ones at zero; the basis at zero
+    /// until [`with_basis`](Self::with_basis).
+    pub(crate) fn new(
+        size: usize,
+        latent: usize,
+        hidden: Option<usize>,
+        init: &Initializer,
+        negative_slope: f64,
+        device: &Device,
+    ) -> Self {
+        let mlp = |from: usize, to: usize| -> Vec<Linear> {
+            let Some(h) = hidden else { return Vec::new() };
+            let layer = |a: usize, b: usize, init: &Initializer| {
+                LinearConfig::new(a, b).with_initializer(init.clone()).init(device)
+            };
+            vec![layer(from, h, init), layer(h, h, init), layer(h, to, &Initializer::Zeros)]
+        };
+        Self {
+            basis: Param::from_tensor(Tensor::zeros([size, INPUT_VALUES], device))
+                .set_require_grad(false),
+            encoder: mlp(size, latent),
+            decoder: mlp(latent, size),
+            size,
+            latent,
+            negative_slope,
+        }
+    }
+
+    /// K, the number of directions.
+    pub fn size(&self) -> usize {
+        self.size
+    }
+
+    /// Sets the basis: `size` rows of `540 * 90 * 90` values in layout order.
+    pub fn with_basis(mut self, rows: &[f32]) -> crate::error::Result<Self> {
+        if rows.len() != self.size * INPUT_VALUES {
+            return Err(ModelError::Invalid(format!(
+                "a basis of {} directions has {} values, got {}",
+                self.size,
+                self.size * INPUT_VALUES,
+                rows.len()
+            )));
+        }
+        if let Some(i) = rows.iter().position(|v| !v.is_finite()) {
+            return Err(ModelError::Invalid(format!("basis value {i} is not finite")));
+        }
+        let data = TensorData::new(rows.to_vec(), [self.size, INPUT_VALUES]);
+        self.basis = self.basis.map(|old| Tensor::from_data(data, &old.device()));
+        self.basis = self.basis.set_require_grad(false);
+        Ok(self)
+    }
+
+    fn mlp(&self, layers: &[Linear], x: Tensor<2>) -> Option<Tensor<2>> {
+        let last = layers.len().checked_sub(1)?;
+        let mut x = x;
+        for (i, layer) in layers.iter().enumerate() {
+            x = layer.forward(x);
+            if i < last {
+                x = leaky_relu(x, self.negative_slope);
+            }
+        }
+        Some(x)
+    }
+
+    /// `U (x - mu)`.
+    ///
+    /// # Shapes
+    /// - centred: `[batch, 540 * 90 * 90]` -> `[batch, K]`
+    pub fn coefficients(&self, centred: Tensor<2>) -> Tensor<2> {
+        centred.matmul(self.basis.val().transpose()) // [batch, K]
+    }
+
+    /// `z = c[..k] + f(c)`.
+    ///
+    /// # Shapes
+    /// - coefficients: `[batch, K]` -> `[batch, k]`
+    pub fn encode(&self, coefficients: Tensor<2>) -> Tensor<2> {
+        let batch = coefficients.dims()[0];
+        let head = coefficients.clone().slice([0..batch, 0..self.latent]); // [batch, k]
+        match self.mlp(&self.encoder, coefficients) {
+            Some(f) => head + f, // [batch, k]
+            None => head,
+        }
+    }
+
+    /// `c_hat = [z, 0] + g(z)`.
+    ///
+    /// # Shapes
+    /// - latent: `[batch, k]` -> `[batch, K]`
+    pub fn decode(&self, latent: Tensor<2>) -> Tensor<2> {
+        let batch = latent.dims()[0];
+        let padded = if self.size > self.latent {
+            let zeros = Tensor::zeros([batch, self.size - self.latent], &latent.device());
+            Tensor::cat(vec![latent.clone(), zeros], 1) // [batch, K]
+        } else {
+            latent.clone()
+        };
+        match self.mlp(&self.decoder, latent) {
+            Some(g) => padded + g, // [batch, K]
+            None => padded,
+        }
+    }
+
+    /// `U^T c_hat`.
+    ///
+    /// # Shapes
+    /// - coefficients: `[batch, K]` -> `[batch, 540 * 90 * 90]`
+    pub fn expand(&self, coefficients: Tensor<2>) -> Tensor<2> {
+        coefficients.matmul(self.basis.val()) // [batch, 540*90*90]
+    }
+}
