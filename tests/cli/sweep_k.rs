@@ -87,8 +87,10 @@ fn sweep_k_writes_results_and_reuses_trained_models() {
         assert!(out.join(f).is_file(), "{f} missing");
     }
     let results = std::fs::read_to_string(out.join("results.csv")).unwrap();
-    // 3 methods x 2 k x 3 materials x 2 measures, plus the header.
-    assert_eq!(results.lines().count(), 1 + 3 * 2 * 3 * 2, "{results}");
+    // 3 methods x 2 k x 3 materials x 3 measures (mapped, cosine-weighted, image RelAE), plus
+    // the header.
+    assert_eq!(results.lines().count(), 1 + 3 * 2 * 3 * 3, "{results}");
+    assert!(out.join("per_material_image_relae.png").is_file());
     let training = std::fs::read_to_string(out.join("training.csv")).unwrap();
     assert_eq!(training.lines().filter(|l| l.contains(",trained,")).count(), 2, "{training}");
     let first_training = training;

@@ -167,9 +167,24 @@ impl ModelArtifact {
         self.config.init(device)?.try_load_record(record).map_err(bad)
     }
 
+    /// [`model`](Self::model) without keeping a copy of the weights: the artifact keeps its
+    /// configuration, provenance, reference and id, and can no longer be saved or loaded into
+    /// a network again (a `cpu` model's weights are ~1.7 GB).
+    pub fn take_model(&mut self, device: &Device) -> Result<Autoencoder> {
+        let bad = |e: burn::store::RecordError| {
+            ModelError::Invalid(format!("the weights do not fit the configuration: {e}"))
+        };
+        let weights = std::mem::take(&mut self.weights);
+        let record = ModuleRecord::from_bytes(Bytes::from_bytes_vec(weights)).map_err(bad)?;
+        self.config.init(device)?.try_load_record(record).map_err(bad)
+    }
+
     /// Writes the artifact directory `dir` (created beside it, then renamed into place).
     /// An existing `dir` is replaced only if it is itself a model artifact.
     pub fn save(&self, dir: &Path) -> Result<()> {
+        if self.weights.is_empty() {
+            return Err(ModelError::Invalid("this artifact's weights were handed over".into()));
+        }
         if dir.exists() && !dir.join(MANIFEST_FILE).is_file() {
             return Err(ModelError::Invalid(format!(
                 "{} exists and is not a DeepBRDF model; not replacing it",

@@ -34,9 +34,9 @@ impl DeepBrdf {
     }
 
     /// Uses an in-memory artifact on `device`.
-    pub fn from_artifact(artifact: ModelArtifact, device: &Device) -> Result<Self> {
+    pub fn from_artifact(mut artifact: ModelArtifact, device: &Device) -> Result<Self> {
         let device = device.clone().without_autodiff();
-        let model = artifact.model(&device)?.valid();
+        let model = artifact.take_model(&device)?.valid();
         Ok(Self { model, artifact, grid_mask: grid_mask(), device })
     }
 
@@ -63,11 +63,6 @@ impl DeepBrdf {
     /// The eq. (1) reference.
     pub fn reference(&self) -> &MedianReference {
         self.artifact.reference()
-    }
-
-    /// The artifact (to save it elsewhere).
-    pub fn artifact(&self) -> &ModelArtifact {
-        &self.artifact
     }
 
     /// Eq. (2): the k latent values of `table`.

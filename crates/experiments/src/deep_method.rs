@@ -11,6 +11,7 @@ use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::harness::{Codec, Method, TrainingSet};
 use deepbrdf_eval::{EvalError, Result};
 use deepbrdf_model::artifact::MODEL_DIR;
+use deepbrdf_model::train::CHECKPOINT_FILE;
 use deepbrdf_model::burn::tensor::Device;
 use deepbrdf_model::{DeepBrdf, ModelArtifact, TrainConfig, TrainingSet as MappedSet};
 use std::path::{Path, PathBuf};
@@ -60,6 +61,10 @@ pub struct DeepMethod {
     next_fold: AtomicUsize,
     fits: Mutex<Vec<FitRecord>>,
     models: Mutex<Vec<(usize, usize, Arc<DeepBrdf>)>>,
+    /// The k whose models stay in memory after their fold (all when `None`; the others are
+    /// loaded again by [`model`](Self::model)): a `cpu` model holds a 1.7 GB basis, 20 of them
+    /// do not fit in memory.
+    retained: Option<Vec<usize>>,
 }
 
 impl DeepMethod {
@@ -74,7 +79,14 @@ impl DeepMethod {
             next_fold: AtomicUsize::new(0),
             fits: Mutex::new(Vec::new()),
             models: Mutex::new(Vec::new()),
+            retained: None,
         }
+    }
+
+    /// Keeps only the models of these k in memory after their fold (see [`model`](Self::model)).
+    pub fn retaining(mut self, ks: &[usize]) -> Self {
+        self.retained = Some(ks.to_vec());
+        self
     }
 
     /// The training directory of (fold, k).
@@ -87,10 +99,17 @@ impl DeepMethod {
         self.fits.lock().map(|f| f.clone()).unwrap_or_default()
     }
 
-    /// The model fitted for (fold, k), once the harness has fitted it.
+    /// The model fitted for (fold, k), once the harness has fitted it: from memory when it was
+    /// retained, else loaded again from its directory.
     pub fn model(&self, fold: usize, k: usize) -> Option<Arc<DeepBrdf>> {
-        let models = self.models.lock().ok()?;
-        models.iter().find(|(f, kk, _)| *f == fold && *kk == k).map(|(_, _, m)| m.clone())
+        let kept = self.models.lock().ok().and_then(|models| {
+            models.iter().find(|(f, kk, _)| *f == fold && *kk == k).map(|(_, _, m)| m.clone())
+        });
+        kept.or_else(|| {
+            let fitted = self.fits().iter().any(|r| r.fold == fold && r.k == k);
+            let dir = Self::dir(&self.models_dir, fold, k);
+            fitted.then(|| DeepBrdf::load(&dir, &self.device).ok().map(Arc::new)).flatten()
+        })
     }
 
     /// Loads or trains the model of (fold, k) on `train`.
@@ -138,6 +157,11 @@ impl DeepMethod {
                                 &self.device,
                             )?;
                             artifact.save(&dir.join(MODEL_DIR))?;
+                            if config.model.spectral_only() {
+                                // Retraining takes seconds; the checkpoint would double the
+                                // ~1 GB on disk. The saved model is what a rerun loads.
+                                let _ = std::fs::remove_file(dir.join(CHECKPOINT_FILE));
+                            }
                             DeepBrdf::from_artifact(artifact, &self.device)
                         })
                         .map_err(|e| model_error(&dir, e))?;
@@ -167,7 +191,9 @@ impl DeepMethod {
             .all(|(_, _, m)| m.reference().values() == model.reference().values());
         let cache = if same_reference { cache.clone() } else { Arc::default() };
         models.retain(|(f, kk, _)| (*f, *kk) != (fold, k));
-        models.push((fold, k, model.clone()));
+        if self.retained.as_ref().is_none_or(|ks| ks.contains(&k)) {
+            models.push((fold, k, model.clone()));
+        }
         Ok(Box::new(DeepCodec { model, cache }))
     }
 

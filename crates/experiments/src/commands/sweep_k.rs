@@ -190,7 +190,14 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
     );
 
     let (pca, ipca) = (NestedBaseline::pca(), NestedBaseline::ipca());
-    let deep = DeepMethod::new(config_for, &models_dir, &data.label, device.clone());
+    // In k-fold mode the models of earlier folds are loaded again when the robustness step
+    // needs them, rather than held in memory.
+    let retained = match args.mode {
+        Mode::KFold { .. } => Vec::new(),
+        _ => fig2_ks.clone(),
+    };
+    let deep =
+        DeepMethod::new(config_for, &models_dir, &data.label, device.clone()).retaining(&retained);
     let materials = Materials { names: &data.names, tables: &data.tables, label: &data.label };
     let results = harness::run(&[&pca, &ipca, &deep], &harness_config, materials, None, progress)?;
     results.write(&out)?;
