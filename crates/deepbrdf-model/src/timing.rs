@@ -73,7 +73,10 @@ pub fn training_steps(
     for step in 0..=steps {
         let start = Instant::now();
         let (value, grads) = match &fit {
-            Some(fit) => coefficient_gradients(&model, &set, fit, &indices, &device)?,
+            Some(fit) => {
+                let inputs = indices.iter().flat_map(|&i| fit.coefficients[i].clone()).collect();
+                coefficient_gradients(&model, &set, fit, &indices, inputs, &device)?
+            }
             None => gradients(&model, &set, &indices, None, offset.as_deref(), threads, &device),
         };
         model = optim.step_multi(1e-5, model, grads);
