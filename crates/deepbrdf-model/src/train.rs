@@ -896,32 +896,51 @@ mod tests {
         // The coordinate loss (plus the distance to the basis' span) is eq. (4) on the full
         // tensors: after training, the logged loss of the last epoch (the model barely moves at
         // the end of the cosine decay) agrees with a full-space evaluation of the trained model.
-        let set = tiny_set(4);
+        // Four BRDFs spanning three directions: k = 1 leaves a linear fit far from exact.
+        let pattern = |i: usize| {
+            [((i % 7) as f32 - 3.0) / 3.0, ((i % 5) as f32 - 2.0) / 2.0, (i % 3) as f32 - 1.0]
+        };
+        let mix = [[1.0, 0.0, 0.3], [-0.5, 1.0, -0.2], [-0.5, -1.0, 0.4], [0.2, 0.4, -0.9]];
+        let mask: Vec<f32> =
+            (0..INPUT_VALUES).map(|i| if i % 11 == 0 { 0.0 } else { 1.0 }).collect();
+        let inputs: Vec<Vec<f32>> = mix
+            .iter()
+            .map(|w| {
+                (0..INPUT_VALUES)
+                    .map(|i| {
+                        let p = pattern(i);
+                        (1.0 + w[0] * p[0] + w[1] * p[1] + w[2] * p[2]) * mask[i]
+                    })
+                    .collect()
+            })
+            .collect();
+        let names = (0..4).map(|b| format!("mixed-{b}")).collect();
+        let set = TrainingSet::from_layouts("mixed", names, inputs, vec![mask; 4]).unwrap();
         let model = AutoencoderConfig::new()
             .with_latent(1)
             .with_mean_offset(true)
             .with_convolutional(false)
-            .with_spectral_basis(Some(2))
-            .with_spectral_hidden(Some(8));
+            .with_spectral_basis(Some(3))
+            .with_spectral_hidden(Some(16));
         let config = TrainConfig::new(model, adam())
-            .with_learning_rate(1e-2)
+            .with_learning_rate(2e-2)
             .with_final_lr_factor(0.01)
-            .with_epochs(150)
+            .with_epochs(500)
             .with_batch_size(4)
             .with_seed(3)
-            .with_checkpoint_seconds(0.0);
+            .with_checkpoint_seconds(1e6); // at the end only: each holds the 52 MB basis
         let device = DeviceKind::default_kind().unwrap().device().unwrap();
         let dir = tempfile::tempdir().unwrap();
         let trained = train(&config, &set, dir.path(), false, &Silent, &device).unwrap();
         let (first, last) = (trained.log[0].loss, trained.log.last().unwrap().loss);
-        assert!(last < 0.5 * first, "loss {first} -> {last}");
+        assert!(last < 0.7 * first, "loss {first} -> {last}");
         let full = trained.mean_mse();
-        assert!((full - last).abs() <= 1e-3 * full + 1e-9, "coordinates {last} vs full {full}");
+        assert!((full - last).abs() <= 1e-2 * full, "coordinates {last} vs full {full}");
         // With slice dropout (on the coordinates of filled inputs) training still fits.
         let dropout = config.clone().with_slice_dropout(Some(SliceDropoutConfig::new()));
         let other = tempfile::tempdir().unwrap();
         let augmented = train(&dropout, &set, other.path(), false, &Silent, &device).unwrap();
-        assert!(augmented.log.last().unwrap().loss < 0.5 * augmented.log[0].loss);
+        assert!(augmented.log.last().unwrap().loss < 0.9 * augmented.log[0].loss);
     }
 
     #[test]
