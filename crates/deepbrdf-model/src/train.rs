@@ -777,7 +777,7 @@ fn load_checkpoint(
 
 /// Whether two JSON values are equal, numbers up to a relative 1e-9 (a number printed and
 /// parsed again by serde_json may come back one unit in the last place away).
-fn json_close(a: &serde_json::Value, b: &serde_json::Value) -> bool {
+pub fn json_close(a: &serde_json::Value, b: &serde_json::Value) -> bool {
     use serde_json::Value;
     match (a, b) {
         (Value::Number(x), Value::Number(y)) => match (x.as_f64(), y.as_f64()) {

@@ -12,7 +12,7 @@ use deepbrdf_eval::harness::{Codec, Method, TrainingSet};
 use deepbrdf_eval::{EvalError, Result};
 use deepbrdf_model::artifact::MODEL_DIR;
 use deepbrdf_model::burn::tensor::Device;
-use deepbrdf_model::train::CHECKPOINT_FILE;
+use deepbrdf_model::train::{json_close, CHECKPOINT_FILE};
 use deepbrdf_model::{DeepBrdf, ModelArtifact, TrainConfig, TrainingSet as MappedSet};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -235,25 +235,6 @@ impl DeepMethod {
             return Ok(None);
         }
         Ok(Some(model))
-    }
-}
-
-/// JSON equality up to the last digits of floating-point numbers (a float written as JSON and
-/// parsed back may differ in its last bit).
-fn json_close(a: &serde_json::Value, b: &serde_json::Value) -> bool {
-    use serde_json::Value;
-    match (a, b) {
-        (Value::Number(x), Value::Number(y)) => match (x.as_f64(), y.as_f64()) {
-            (Some(x), Some(y)) => x == y || (x - y).abs() <= 1e-12 * x.abs().max(y.abs()),
-            _ => x == y,
-        },
-        (Value::Array(x), Value::Array(y)) => {
-            x.len() == y.len() && x.iter().zip(y).all(|(x, y)| json_close(x, y))
-        }
-        (Value::Object(x), Value::Object(y)) => {
-            x.len() == y.len() && x.iter().all(|(k, v)| y.get(k).is_some_and(|w| json_close(v, w)))
-        }
-        _ => a == b,
     }
 }
 
