@@ -63,6 +63,25 @@ pub struct Provenance {
     pub device: String,
 }
 
+impl Provenance {
+    /// The provenance of a network that was not trained on data (synthetic weights for tests and
+    /// benchmarks), labelled `label`.
+    pub fn untrained(label: &str, seed: u64) -> Self {
+        Self {
+            data_label: label.into(),
+            materials: Vec::new(),
+            data_fingerprint: String::new(),
+            train_config: serde_json::Value::Null,
+            seed,
+            epochs: 0,
+            final_loss: 0.0,
+            final_mse: 0.0,
+            train_seconds: 0.0,
+            device: String::new(),
+        }
+    }
+}
+
 /// Checksum of one part file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 struct Part {

@@ -116,6 +116,18 @@ impl AutoencoderConfig {
             .with_spectral_hidden(Some(CPU_SPECTRAL_HIDDEN))
     }
 
+    /// A spectral-only network ([`crate::spectral`]): latent dimension `k`, `size` principal
+    /// directions, coefficient-space MLPs of width `hidden` (none: linear), the mean offset, no
+    /// convolutions. [`cpu`](Self::cpu) is one, with sizes chosen for the MERL collection.
+    pub fn spectral(k: usize, size: usize, hidden: Option<usize>) -> Self {
+        Self::new()
+            .with_latent(k)
+            .with_mean_offset(true)
+            .with_convolutional(false)
+            .with_spectral_basis(Some(size))
+            .with_spectral_hidden(hidden)
+    }
+
     /// Whether training can run on the spectral coefficients alone (no convolutions).
     pub fn spectral_only(&self) -> bool {
         !self.convolutional && self.spectral_basis.is_some()
@@ -420,6 +432,16 @@ impl Autoencoder {
         self.spectral.as_ref()
     }
 
+    /// Moves the spectral path's basis out ([`SpectralPath::take_basis`]); the network can then
+    /// no longer encode or decode by itself.
+    pub(crate) fn take_basis(&mut self) -> crate::error::Result<Vec<f32>> {
+        let path = self
+            .spectral
+            .as_mut()
+            .ok_or_else(|| ModelError::Invalid("this configuration has no spectral path".into()))?;
+        path.take_basis()
+    }
+
     /// The latent dimension k.
     pub fn latent(&self) -> usize {
         self.latent
@@ -609,12 +631,7 @@ mod tests {
         // Three orthonormal directions (disjoint supports) and an offset, k = 2: before
         // training, encode gives the projections on the first two and decode rebuilds the offset
         // plus their combination; the third direction is what k = 2 loses.
-        let config = AutoencoderConfig::new()
-            .with_latent(2)
-            .with_mean_offset(true)
-            .with_convolutional(false)
-            .with_spectral_basis(Some(3))
-            .with_spectral_hidden(Some(4));
+        let config = AutoencoderConfig::spectral(2, 3, Some(4));
         assert!(config.clone().with_mean_offset(false).validate().is_err());
         assert!(config.clone().with_spectral_basis(Some(1)).validate().is_err());
         assert!(config.clone().with_spectral_basis(None).validate().is_err());

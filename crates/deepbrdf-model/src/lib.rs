@@ -2,12 +2,14 @@
 //!
 //! - [`autoencoder`]: Table 1 and the CPU preset; [`loss`]: eq. (4).
 //! - [`training_set`], [`train`]: mapped layouts, Adam, checkpoints that resume exactly.
-//! - [`artifact`]: the self-contained saved model; [`codec`]: encode / decode with it.
+//! - [`artifact`]: the self-contained saved model; [`codec`]: encode / decode with it;
+//!   [`compact`]: the spectral basis in the compact form the codec decodes with.
 //! - [`fit`]: all of the above on a set of MERL tables.
 pub mod artifact;
 mod atomic;
 pub mod autoencoder;
 pub mod codec;
+pub mod compact;
 mod container;
 pub mod device;
 pub mod error;

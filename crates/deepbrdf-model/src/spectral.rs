@@ -25,7 +25,8 @@ use crate::error::ModelError;
 #[derive(Module, Debug)]
 pub struct SpectralPath {
     /// `[K, 540 * 90 * 90]`: orthonormal rows (zero rows past the training set's rank). Fixed.
-    basis: Param<Tensor<2>>,
+    /// `None` once the codec has taken it ([`take_basis`](Self::take_basis)).
+    basis: Option<Param<Tensor<2>>>,
     /// f: K -> hidden -> hidden -> k (empty: none).
     encoder: Vec<Linear>,
     /// g: k -> hidden -> hidden -> K (empty: none).
@@ -55,8 +56,10 @@ impl SpectralPath {
             vec![layer(from, h, init), layer(h, h, init), layer(h, to, &Initializer::Zeros)]
         };
         Self {
-            basis: Param::from_tensor(Tensor::zeros([size, INPUT_VALUES], device))
-                .set_require_grad(false),
+            basis: Some(
+                Param::from_tensor(Tensor::zeros([size, INPUT_VALUES], device))
+                    .set_require_grad(false),
+            ),
             encoder: mlp(size, latent),
             decoder: mlp(latent, size),
             size,
@@ -83,10 +86,28 @@ impl SpectralPath {
         if let Some(i) = rows.iter().position(|v| !v.is_finite()) {
             return Err(ModelError::Invalid(format!("basis value {i} is not finite")));
         }
+        let old = self.basis.take().ok_or_else(taken)?;
         let data = TensorData::new(rows.to_vec(), [self.size, INPUT_VALUES]);
-        self.basis = self.basis.map(|old| Tensor::from_data(data, &old.device()));
-        self.basis = self.basis.set_require_grad(false);
+        let param = old.map(|old| Tensor::from_data(data, &old.device()));
+        self.basis = Some(param.set_require_grad(false));
         Ok(self)
+    }
+
+    /// Moves the basis out (`K * 540 * 90 * 90` values, row-major), for a codec that stores
+    /// it its own way ([`crate::compact`]); afterwards only [`encode`](Self::encode) and
+    /// [`decode`](Self::decode), the coordinate-space networks, are usable.
+    pub fn take_basis(&mut self) -> crate::error::Result<Vec<f32>> {
+        let basis = self.basis.take().ok_or_else(taken)?;
+        basis
+            .val()
+            .into_data()
+            .try_into_vec()
+            .map_err(|e| ModelError::Invalid(format!("reading the spectral basis failed: {e:?}")))
+    }
+
+    fn basis(&self) -> Tensor<2> {
+        // Only `DeepBrdf` takes the basis, and it never projects or expands with the network.
+        self.basis.as_ref().map(|b| b.val()).expect("the spectral basis was taken by a codec")
     }
 
     fn mlp(&self, layers: &[Linear], x: Tensor<2>) -> Option<Tensor<2>> {
@@ -106,7 +127,7 @@ impl SpectralPath {
     /// # Shapes
     /// - centred: `[batch, 540 * 90 * 90]` -> `[batch, K]`
     pub fn coefficients(&self, centred: Tensor<2>) -> Tensor<2> {
-        centred.matmul(self.basis.val().transpose()) // [batch, K]
+        centred.matmul(self.basis().transpose()) // [batch, K]
     }
 
     /// `z = c[..k] + f(c)`.
@@ -145,6 +166,10 @@ impl SpectralPath {
     /// # Shapes
     /// - coefficients: `[batch, K]` -> `[batch, 540 * 90 * 90]`
     pub fn expand(&self, coefficients: Tensor<2>) -> Tensor<2> {
-        coefficients.matmul(self.basis.val()) // [batch, 540*90*90]
+        coefficients.matmul(self.basis()) // [batch, 540*90*90]
     }
+}
+
+fn taken() -> ModelError {
+    ModelError::Invalid("this spectral path's basis was already taken".into())
 }

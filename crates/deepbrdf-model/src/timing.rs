@@ -1,6 +1,6 @@
 //! Speed measurements of the networks, for `experiments bench model`: seconds per training step
 //! (forward, eq. (4) loss, backward, Adam) and seconds to decode a latent vector into a full
-//! MERL table. Inputs are synthetic (random mapped values on the MERL grid's mask): speed does
+//! MERL table (through the codec, [`DeepBrdf`]). Inputs are synthetic (random mapped values on the MERL grid's mask): speed does
 //! not depend on the values.
 
 use std::time::Instant;
@@ -13,8 +13,9 @@ use deepbrdf_data::merl::VALUES;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::autoencoder::AutoencoderConfig;
-use crate::codec::grid_mask;
+use crate::artifact::{ModelArtifact, Provenance};
+use crate::autoencoder::{AutoencoderConfig, INPUT_VALUES};
+use crate::codec::{grid_mask, DeepBrdf};
 use crate::error::{ModelError, Result};
 use crate::train::{coefficient_gradients, gradients};
 use crate::training_set::TrainingSet;
@@ -101,31 +102,74 @@ fn synthetic_set(n: usize) -> Result<TrainingSet> {
     TrainingSet::from_layouts("random", names, inputs, vec![mask; n])
 }
 
-/// Times decoding one latent vector into a full MERL table (network, inverse layout, inverse
-/// eq. (1) on the grid's valid cells): `(network only, whole decode)` over `repeats` runs
-/// after one warm-up.
-pub fn decode(
-    config: &AutoencoderConfig,
-    repeats: usize,
-    device: &Device,
-) -> Result<(Timing, Timing)> {
+/// Decode timings, medians over repeated runs.
+#[derive(Debug, Clone)]
+pub struct DecodeTiming {
+    /// The codec's network part: latent to the mapped 540 x 90 x 90 layout.
+    pub network: Timing,
+    /// The whole decode: network, inverse layout, inverse eq. (1) on the grid's valid cells.
+    pub whole: Timing,
+    /// For a spectral-only network, the same network part through the network's own f32
+    /// matrix product with the full basis (what the codec's compact basis replaces), timed in
+    /// the same run as the baseline.
+    pub f32_network: Option<Timing>,
+}
+
+/// Times decoding one latent vector into a full MERL table through [`DeepBrdf`], as `decode`
+/// and the evaluation use it, over `repeats` runs after one warm-up. A spectral network gets a
+/// basis and offset of seeded random values on the grid's valid cells (speed does not depend on
+/// the values, but the compact basis does depend on their support).
+pub fn decode(config: &AutoencoderConfig, repeats: usize, device: &Device) -> Result<DecodeTiming> {
     let device = device.clone().without_autodiff();
-    let model = config.init_seeded(0, &device)?;
+    let mut model = config.init_seeded(0, &device)?;
+    let valid = mask_layout(&grid_mask());
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    if config.mean_offset {
+        let offset: Vec<f32> = valid.iter().map(|&m| m * rng.random_range(-1.0..1.0f32)).collect();
+        model = model.with_offset(&offset)?;
+    }
+    if let Some(size) = config.spectral_basis {
+        let scale = 1.0 / (INPUT_VALUES as f32).sqrt();
+        let basis: Vec<f32> = (0..size * INPUT_VALUES)
+            .map(|i| valid[i % INPUT_VALUES] * scale * rng.random_range(-1.0..1.0f32))
+            .collect();
+        model = model.with_basis(&basis)?;
+    }
+    let latent: Vec<f32> = (0..config.latent).map(|i| 0.1 * (i as f32 - 2.0)).collect();
+    let f32_network = if config.spectral_only() {
+        let mut runs = Vec::new();
+        for run in 0..=repeats.max(1) {
+            let start = Instant::now();
+            let z = Tensor::<2>::from_data(
+                TensorData::new(latent.clone(), [1, config.latent]),
+                &device,
+            );
+            let out: Vec<f32> =
+                model.decode(z).into_data().try_into_vec().map_err(|e| {
+                    ModelError::Invalid(format!("reading a tensor back failed: {e:?}"))
+                })?;
+            std::hint::black_box(out);
+            if run > 0 {
+                runs.push(start.elapsed().as_secs_f64());
+            }
+        }
+        Some(Timing { runs })
+    } else {
+        None
+    };
+    let provenance = Provenance::untrained("benchmark", 0);
     let reference = MedianReference::from_values(vec![0.05; VALUES])?;
+    let artifact = ModelArtifact::new(config.clone(), provenance, &model, reference)?;
+    drop(model);
+    let codec = DeepBrdf::from_artifact(artifact, &device)?;
     let mask = grid_mask();
     let mut network = Vec::new();
     let mut whole = Vec::new();
     for run in 0..=repeats.max(1) {
-        let latent: Vec<f32> = (0..config.latent).map(|i| 0.1 * (i as f32 - 2.0)).collect();
         let start = Instant::now();
-        let z = Tensor::<2>::from_data(TensorData::new(latent, [1, config.latent]), &device);
-        let out: Vec<f32> = model
-            .decode(z)
-            .into_data()
-            .try_into_vec()
-            .map_err(|e| ModelError::Invalid(format!("reading a tensor back failed: {e:?}")))?;
+        let out = codec.decode_layout(&latent)?;
         let net = start.elapsed().as_secs_f64();
-        let table = reference.unmap(&from_layout(&out), &mask)?;
+        let table = codec.reference().unmap(&from_layout(&out), &mask)?;
         let total = start.elapsed().as_secs_f64();
         std::hint::black_box(table);
         if run > 0 {
@@ -133,5 +177,9 @@ pub fn decode(
             whole.push(total);
         }
     }
-    Ok((Timing { runs: network }, Timing { runs: whole }))
+    Ok(DecodeTiming {
+        network: Timing { runs: network },
+        whole: Timing { runs: whole },
+        f32_network,
+    })
 }

@@ -916,12 +916,7 @@ mod tests {
             .collect();
         let names = (0..4).map(|b| format!("mixed-{b}")).collect();
         let set = TrainingSet::from_layouts("mixed", names, inputs, vec![mask; 4]).unwrap();
-        let model = AutoencoderConfig::new()
-            .with_latent(1)
-            .with_mean_offset(true)
-            .with_convolutional(false)
-            .with_spectral_basis(Some(3))
-            .with_spectral_hidden(Some(16));
+        let model = AutoencoderConfig::spectral(1, 3, Some(16));
         let config = TrainConfig::new(model, adam())
             .with_learning_rate(2e-2)
             .with_final_lr_factor(0.01)
