@@ -314,7 +314,7 @@ impl Report<'_> {
         if let (Some(d), Some(i), Some(p)) = (m(NAME, k0), m("IPCA", k0), m("PCA", k0)) {
             let _ = writeln!(
                 s,
-                "- k = {k0}: {NAME} {d:.4e} vs IPCA {i:.4e} ({:.2}x) and PCA {p:.4e} ({:.2}x): {NAME} is {} both.",
+                "- k = {k0}: {NAME} {d:.4e} vs IPCA {i:.4e} and PCA {p:.4e} (error ratios IPCA/{NAME} {:.2}, PCA/{NAME} {:.2}): {NAME} is {} both.",
                 i / d,
                 p / d,
                 if d < i && d < p { "below" } else { "NOT below" }
