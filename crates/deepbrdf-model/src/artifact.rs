@@ -6,9 +6,12 @@
 //!   model.json             id, network configuration, training provenance, part checksums
 //!   weights.bpk            the network's parameters (burnpack, Burn's record format)
 //!   median_reference.bin   the eq. (1) reference of the training data (deepbrdf-data format)
+//!   basis.f16              spectral-only networks (the `cpu` preset): the basis, compact
+//!                          (crate::compact: its support, f16); weights.bpk then lacks it
 //! ```
 //!
-//! The id is a SHA-256 over the configuration, the provenance and the checksums of both parts,
+//! Version 1 directories (the basis in f32 inside `weights.bpk`, no `basis.f16`) still load.
+//! The id is a SHA-256 over the configuration, the provenance and the checksums of the parts,
 //! so editing `model.json` or swapping in the weights or reference of another model is detected
 //! when loading. The directory is written beside its destination and renamed into place.
 
@@ -24,6 +27,7 @@ use sha2::{Digest, Sha256};
 
 use crate::atomic::{read_limited, sync_parent, write_atomic};
 use crate::autoencoder::{Autoencoder, AutoencoderConfig};
+use crate::compact::CompactBasis;
 use crate::error::{ModelError, Result};
 use crate::train::Trained;
 
@@ -33,10 +37,12 @@ pub const MANIFEST_FILE: &str = "model.json";
 pub const WEIGHTS_FILE: &str = "weights.bpk";
 /// File name of the median reference.
 pub const REFERENCE_FILE: &str = "median_reference.bin";
+/// File name of the compact spectral basis.
+pub const BASIS_FILE: &str = "basis.f16";
 /// Name of the artifact directory that training writes inside its output directory.
 pub const MODEL_DIR: &str = "model";
 const FORMAT: &str = "deepbrdf-model";
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 
 /// How a model was trained (§3.2's settings and the data), recorded with the model.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -100,6 +106,8 @@ struct Manifest {
     provenance: Provenance,
     weights: Part,
     reference: Part,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    basis: Option<Part>,
 }
 
 /// A trained model with its median reference and provenance, in memory.
@@ -108,6 +116,8 @@ pub struct ModelArtifact {
     config: AutoencoderConfig,
     provenance: Provenance,
     weights: Vec<u8>,
+    /// A spectral-only network's basis, serialised compact ([`CompactBasis::to_bytes`]).
+    basis: Option<Vec<u8>>,
     reference: MedianReference,
     id: String,
 }
@@ -145,14 +155,50 @@ impl ModelArtifact {
         model: &Autoencoder,
         reference: MedianReference,
     ) -> Result<Self> {
+        Self::assemble(config, provenance, model, reference, true)
+    }
+
+    /// A spectral-only network's basis left inside the weights in f32, as version 1 saved it.
+    #[cfg(test)]
+    pub(crate) fn new_uncompacted(
+        config: AutoencoderConfig,
+        provenance: Provenance,
+        model: &Autoencoder,
+        reference: MedianReference,
+    ) -> Result<Self> {
+        Self::assemble(config, provenance, model, reference, false)
+    }
+
+    fn assemble(
+        config: AutoencoderConfig,
+        provenance: Provenance,
+        model: &Autoencoder,
+        reference: MedianReference,
+        compact: bool,
+    ) -> Result<Self> {
+        let mut model = model.clone();
+        let basis = match config.spectral_basis {
+            Some(size) if compact && config.spectral_only() => {
+                let rows = model.take_basis()?;
+                let offset = model.offset().ok_or_else(|| {
+                    ModelError::Invalid("a spectral network without its offset".into())
+                })?;
+                Some(CompactBasis::new(&rows, size, &offset)?.to_bytes())
+            }
+            _ => None,
+        };
         let weights = model
-            .clone()
             .into_record()
             .into_bytes()
             .map_err(|e| ModelError::Invalid(format!("cannot serialise the weights: {e}")))?
             .to_vec();
-        let mut artifact = Self { config, provenance, weights, reference, id: String::new() };
-        artifact.id = artifact.manifest_id(&artifact.weights_part(), &artifact.reference_part());
+        let mut artifact =
+            Self { config, provenance, weights, basis, reference, id: String::new() };
+        artifact.id = artifact.manifest_id(
+            &artifact.weights_part(),
+            &artifact.reference_part(),
+            artifact.basis_part().as_ref(),
+        );
         Ok(artifact)
     }
 
@@ -176,26 +222,36 @@ impl ModelArtifact {
         &self.reference
     }
 
-    /// Builds the network on `device` and loads the weights into it.
+    /// Builds the whole network on `device` and loads the weights into it. A network whose
+    /// basis is stored compact cannot be rebuilt in f32: use [`crate::DeepBrdf`] for it.
     pub fn model(&self, device: &Device) -> Result<Autoencoder> {
-        let bad = |e: burn::store::RecordError| {
-            ModelError::Invalid(format!("the weights do not fit the configuration: {e}"))
-        };
-        let record =
-            ModuleRecord::from_bytes(Bytes::from_bytes_vec(self.weights.clone())).map_err(bad)?;
-        self.config.init(device)?.try_load_record(record).map_err(bad)
+        if self.basis.is_some() {
+            return Err(ModelError::Invalid(
+                "this model's spectral basis is stored compact (f16); load it with DeepBrdf".into(),
+            ));
+        }
+        load_weights(self.config.init(device)?, self.weights.clone())
     }
 
-    /// [`model`](Self::model) without keeping a copy of the weights: the artifact keeps its
-    /// configuration, provenance, reference and id, and can no longer be saved or loaded into
-    /// a network again (a `cpu` model's weights are ~1.7 GB).
-    pub fn take_model(&mut self, device: &Device) -> Result<Autoencoder> {
-        let bad = |e: burn::store::RecordError| {
-            ModelError::Invalid(format!("the weights do not fit the configuration: {e}"))
-        };
+    /// The network and, for a spectral-only one saved with it, its compact basis (the network
+    /// then lacks its own basis: it can run its coordinate-space MLPs only), without keeping a
+    /// copy of the weights: the artifact keeps its configuration, provenance, reference and id,
+    /// and can no longer be saved or loaded into a network again.
+    pub fn take_model(&mut self, device: &Device) -> Result<(Autoencoder, Option<CompactBasis>)> {
         let weights = std::mem::take(&mut self.weights);
-        let record = ModuleRecord::from_bytes(Bytes::from_bytes_vec(weights)).map_err(bad)?;
-        self.config.init(device)?.try_load_record(record).map_err(bad)
+        let Some(bytes) = self.basis.take() else {
+            return Ok((load_weights(self.config.init(device)?, weights)?, None));
+        };
+        let basis = CompactBasis::from_bytes(&bytes)
+            .map_err(|e| ModelError::Invalid(format!("{BASIS_FILE}: {e}")))?;
+        if Some(basis.size()) != self.config.spectral_basis {
+            return Err(ModelError::Invalid(format!(
+                "{BASIS_FILE} has {} directions, the configuration {:?}",
+                basis.size(),
+                self.config.spectral_basis
+            )));
+        }
+        Ok((load_weights(self.config.init_without_basis(device)?, weights)?, Some(basis)))
     }
 
     /// Writes the artifact directory `dir` (created beside it, then renamed into place).
@@ -225,6 +281,9 @@ impl ModelArtifact {
 
     fn write_parts(&self, dir: &Path) -> Result<()> {
         write_atomic(&dir.join(WEIGHTS_FILE), &[&self.weights])?;
+        if let Some(basis) = &self.basis {
+            write_atomic(&dir.join(BASIS_FILE), &[basis])?;
+        }
         self.reference.save(dir.join(REFERENCE_FILE))?;
         let manifest = Manifest {
             format: FORMAT.into(),
@@ -234,6 +293,7 @@ impl ModelArtifact {
             provenance: self.provenance.clone(),
             weights: self.weights_part(),
             reference: self.reference_part(),
+            basis: self.basis_part(),
         };
         let json = serde_json::to_string_pretty(&manifest)
             .map_err(|e| ModelError::Invalid(format!("cannot serialise the manifest: {e}")))?;
@@ -249,11 +309,11 @@ impl ModelArtifact {
         let manifest: Manifest = serde_json::from_slice(&text).map_err(|e| {
             ModelError::format(&manifest_path, format!("not a DeepBRDF model manifest: {e}"))
         })?;
-        if manifest.format != FORMAT || manifest.version != VERSION {
+        if manifest.format != FORMAT || !(1..=VERSION).contains(&manifest.version) {
             return Err(ModelError::format(
                 &manifest_path,
                 format!(
-                    "format {} version {}, expected {FORMAT} version {VERSION}",
+                    "format {} version {}, expected {FORMAT} version 1 to {VERSION}",
                     manifest.format, manifest.version
                 ),
             ));
@@ -267,12 +327,30 @@ impl ModelArtifact {
                 format!("these weights do not belong to model {} (checksum differs)", manifest.id),
             ));
         }
+        let basis = match &manifest.basis {
+            Some(part) => {
+                let basis_path = dir.join(BASIS_FILE);
+                let bytes = read_limited(&basis_path, 4 << 30)?;
+                if &part_of(&bytes, BASIS_FILE) != part {
+                    return Err(ModelError::mismatch(
+                        &basis_path,
+                        format!(
+                            "this basis does not belong to model {} (checksum differs)",
+                            manifest.id
+                        ),
+                    ));
+                }
+                Some(bytes)
+            }
+            None => None,
+        };
         let reference_path = dir.join(REFERENCE_FILE);
         let reference = MedianReference::load(&reference_path)?;
         let artifact = Self {
             config: manifest.config,
             provenance: manifest.provenance,
             weights,
+            basis,
             reference,
             id: manifest.id,
         };
@@ -285,7 +363,8 @@ impl ModelArtifact {
                 ),
             ));
         }
-        let expected = artifact.manifest_id(&manifest.weights, &manifest.reference);
+        let expected =
+            artifact.manifest_id(&manifest.weights, &manifest.reference, manifest.basis.as_ref());
         if expected != artifact.id {
             return Err(ModelError::mismatch(
                 &manifest_path,
@@ -297,6 +376,10 @@ impl ModelArtifact {
 
     fn weights_part(&self) -> Part {
         part_of(&self.weights, WEIGHTS_FILE)
+    }
+
+    fn basis_part(&self) -> Option<Part> {
+        self.basis.as_ref().map(|b| part_of(b, BASIS_FILE))
     }
 
     /// The reference's checksum is taken over its values (little-endian f32), not over the
@@ -313,16 +396,29 @@ impl ModelArtifact {
         }
     }
 
-    fn manifest_id(&self, weights: &Part, reference: &Part) -> String {
-        let content = serde_json::json!({
+    /// A version 1 model (no basis part) keeps its id: the basis enters only when present.
+    fn manifest_id(&self, weights: &Part, reference: &Part, basis: Option<&Part>) -> String {
+        let mut content = serde_json::json!({
             "config": self.config,
             "provenance": self.provenance,
             "weights": weights,
             "reference": reference,
         });
+        if let Some(basis) = basis {
+            content["basis"] = serde_json::json!(basis);
+        }
         let digest = Sha256::digest(canonical(content).to_string().as_bytes());
         hex::encode(&digest[..16])
     }
+}
+
+/// Loads burnpack `weights` into `network`.
+fn load_weights(network: Autoencoder, weights: Vec<u8>) -> Result<Autoencoder> {
+    let bad = |e: burn::store::RecordError| {
+        ModelError::Invalid(format!("the weights do not fit the configuration: {e}"))
+    };
+    let record = ModuleRecord::from_bytes(Bytes::from_bytes_vec(weights)).map_err(bad)?;
+    network.try_load_record(record).map_err(bad)
 }
 
 /// `value` with every non-integer number replaced by its 10-significant-digit text, so the id

@@ -36,7 +36,7 @@ pub const BOTTLENECK_SIDE: usize = 12;
 /// K of the `cpu` preset's spectral path: 96 principal directions of the training set (100
 /// materials span 99; with 48 the 51 left out still carried 6e-4 of mapped-space MSE, above what
 /// nearest-slice filling loses from 1/9 of the slices). The basis is stored in the model:
-/// 96 x 4.37 M f32 values, 1.7 GB.
+/// 96 x 4.37 M values, 1.7 GB in f32 while training, 0.67 GB as saved ([`crate::compact`]).
 pub const CPU_SPECTRAL_BASIS: usize = 96;
 /// Width of the `cpu` preset's coefficient-space MLPs.
 pub const CPU_SPECTRAL_HIDDEN: usize = 256;
@@ -209,6 +209,16 @@ impl AutoencoderConfig {
 
     /// Builds the network on `device` with freshly initialised weights (and a zero offset).
     pub fn init(&self, device: &Device) -> crate::error::Result<Autoencoder> {
+        self.build(device, true)
+    }
+
+    /// [`init`](Self::init) without the spectral path's basis (`K x 540 x 90 x 90` values),
+    /// for loading the weights of a model whose basis is stored apart ([`crate::compact`]).
+    pub(crate) fn init_without_basis(&self, device: &Device) -> crate::error::Result<Autoencoder> {
+        self.build(device, false)
+    }
+
+    fn build(&self, device: &Device, allocate_basis: bool) -> crate::error::Result<Autoencoder> {
         self.validate()?;
         let [e0, e1, e2] = self.encoder_channels;
         let [d0, d1] = self.decoder_channels;
@@ -286,6 +296,7 @@ impl AutoencoderConfig {
                     self.spectral_hidden,
                     &hidden,
                     self.negative_slope,
+                    allocate_basis,
                     device,
                 )
             }),

@@ -41,8 +41,11 @@ impl DeepBrdf {
     /// Uses an in-memory artifact on `device`.
     pub fn from_artifact(mut artifact: ModelArtifact, device: &Device) -> Result<Self> {
         let device = device.clone().without_autodiff();
-        let mut model = artifact.take_model(&device)?.valid();
+        let (model, compact) = artifact.take_model(&device)?;
+        let mut model = model.valid();
         let basis = match artifact.config().spectral_basis {
+            _ if compact.is_some() => compact,
+            // A version 1 model: the f32 basis is in the network.
             Some(size) if artifact.config().spectral_only() => {
                 let rows = model.take_basis()?;
                 let offset = model.offset().ok_or_else(|| {
@@ -188,7 +191,7 @@ fn read_error(e: impl std::fmt::Debug) -> ModelError {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::artifact::Provenance;
+    use crate::artifact::{Provenance, BASIS_FILE, WEIGHTS_FILE};
     use crate::device::DeviceKind;
     use deepbrdf_data::merl::{read_merl, write_merl, VALUES};
 
@@ -209,25 +212,72 @@ mod tests {
         DeepBrdf::from_artifact(artifact, &device).unwrap()
     }
 
-    #[test]
-    fn a_spectral_codec_matches_its_network_within_half_precision() {
-        // K = 3 directions of seeded random values on the grid's valid cells, an offset there,
-        // k = 2: the codec's compact f16 basis against the network's own f32 matmuls.
-        let device = DeviceKind::default_kind().unwrap().device().unwrap();
+    fn noise(seed: usize, i: usize) -> f32 {
+        ((i * 7919 + seed * 104729) % 1000) as f32 / 1000.0
+    }
+
+    /// K = 3 directions of seeded pseudo-random values on the grid's valid cells, an offset
+    /// there, k = 2; with the offset.
+    fn spectral_network(device: &Device) -> (AutoencoderConfig, Autoencoder, Vec<f32>) {
         let config = AutoencoderConfig::spectral(2, 3, Some(4));
         let valid = mask_layout(&grid_mask());
-        let noise = |seed: usize, i: usize| ((i * 7919 + seed * 104729) % 1000) as f32 / 1000.0;
         let basis: Vec<f32> = (0..3 * INPUT_VALUES)
             .map(|i| valid[i % INPUT_VALUES] * (noise(1, i) - 0.5) * 1e-3)
             .collect();
         let offset: Vec<f32> = (0..INPUT_VALUES).map(|i| valid[i] * (noise(2, i) - 0.3)).collect();
         let network = config
-            .init_seeded(4, &device)
+            .init_seeded(4, device)
             .unwrap()
             .with_offset(&offset)
             .unwrap()
             .with_basis(&basis)
             .unwrap();
+        (config, network, offset)
+    }
+
+    #[test]
+    fn spectral_models_save_their_basis_compact_and_version_1_models_still_load() {
+        let device = DeviceKind::default_kind().unwrap().device().unwrap();
+        let (config, network, _) = spectral_network(&device);
+        let reference = MedianReference::from_values(vec![0.2; VALUES]).unwrap();
+        let provenance = Provenance::untrained("synthetic", 4);
+        let compact =
+            ModelArtifact::new(config.clone(), provenance.clone(), &network, reference.clone())
+                .unwrap();
+        let v1 = ModelArtifact::new_uncompacted(config, provenance, &network, reference).unwrap();
+        assert!(compact.model(&device).is_err(), "no f32 network from an f16 basis");
+        let root = tempfile::tempdir().unwrap();
+        let (a, b) = (root.path().join("compact"), root.path().join("v1"));
+        compact.save(&a).unwrap();
+        v1.save(&b).unwrap();
+        let size = |p: std::path::PathBuf| std::fs::metadata(p).unwrap().len();
+        // The weights keep the f32 offset (one layout) and the MLPs, not the 3 basis rows.
+        let one_layout = 4 * INPUT_VALUES as u64;
+        assert!(size(a.join(WEIGHTS_FILE)) < one_layout + (1 << 20), "the basis left the weights");
+        assert!(size(b.join(WEIGHTS_FILE)) > 4 * one_layout);
+        assert!(a.join(BASIS_FILE).is_file() && !b.join(BASIS_FILE).exists());
+        // Both decode through the same compact basis: the same values.
+        let z = [0.3f32, -0.6];
+        let from_a = DeepBrdf::load(&a, &device).unwrap().decode_layout(&z).unwrap();
+        let from_b = DeepBrdf::load(&b, &device).unwrap().decode_layout(&z).unwrap();
+        let in_memory = DeepBrdf::from_artifact(compact, &device).unwrap();
+        assert_eq!(from_a, from_b);
+        assert_eq!(from_a, in_memory.decode_layout(&z).unwrap());
+        // A damaged basis file is named.
+        let mut bytes = std::fs::read(a.join(BASIS_FILE)).unwrap();
+        let last = bytes.len() - 1;
+        bytes[last] ^= 1;
+        std::fs::write(a.join(BASIS_FILE), bytes).unwrap();
+        let err = DeepBrdf::load(&a, &device).unwrap_err().to_string();
+        assert!(err.contains(BASIS_FILE) && err.contains("not belong"), "{err}");
+    }
+
+    #[test]
+    fn a_spectral_codec_matches_its_network_within_half_precision() {
+        // The codec's compact f16 basis against the network's own f32 matmuls.
+        let device = DeviceKind::default_kind().unwrap().device().unwrap();
+        let (config, network, offset) = spectral_network(&device);
+        let valid = mask_layout(&grid_mask());
         let provenance = Provenance::untrained("synthetic", 4);
         let reference = MedianReference::from_values(vec![0.2; VALUES]).unwrap();
         let artifact = ModelArtifact::new(config, provenance, &network, reference).unwrap();

@@ -19,6 +19,13 @@ use crate::error::{ModelError, Result};
 /// Values (support cells) per parallel chunk; a fixed size, so sums run in a fixed order.
 const CHUNK: usize = 1 << 14;
 
+/// First bytes of a serialised compact basis ([`CompactBasis::to_bytes`]).
+const MAGIC: &[u8; 8] = b"DBRDFCB\0";
+/// Version of that serialisation.
+const FORMAT_VERSION: u32 = 1;
+/// Bytes of its header: magic, version, K, support length.
+const HEADER: usize = 8 + 3 * 4;
+
 /// Support values per tile of the transposition in [`CompactBasis::new`].
 const TILE: usize = 512;
 
@@ -99,6 +106,75 @@ impl CompactBasis {
     /// How many layout values the support holds.
     pub fn support_len(&self) -> usize {
         self.support.len()
+    }
+
+    /// The basis as bytes (little-endian): `DBRDFCB\0`, version (u32), K (u32), support length
+    /// n (u32), the support (n u32), the offset on it (n f32), K unscale factors (f32), the
+    /// values (n K f16).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let n = self.support.len();
+        let mut out = Vec::with_capacity(HEADER + 8 * n + 4 * self.size + 2 * self.values.len());
+        out.extend_from_slice(MAGIC);
+        for v in [FORMAT_VERSION, self.size as u32, n as u32] {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+        self.support.iter().for_each(|v| out.extend_from_slice(&v.to_le_bytes()));
+        self.offset.iter().for_each(|v| out.extend_from_slice(&v.to_le_bytes()));
+        self.unscale.iter().for_each(|v| out.extend_from_slice(&v.to_le_bytes()));
+        self.values.iter().for_each(|v| out.extend_from_slice(&v.to_le_bytes()));
+        out
+    }
+
+    /// Reads [`to_bytes`](Self::to_bytes)' format, checking every size against the byte count
+    /// before allocating and every value for sense; the error says what is wrong.
+    pub fn from_bytes(bytes: &[u8]) -> std::result::Result<Self, String> {
+        if bytes.len() < HEADER || &bytes[..8] != MAGIC {
+            return Err("not a DeepBRDF compact basis (bad magic or too short)".into());
+        }
+        let word = |i: usize| u32::from_le_bytes(bytes[8 + 4 * i..12 + 4 * i].try_into().unwrap());
+        let (version, size, n) = (word(0), word(1) as usize, word(2) as usize);
+        if version != FORMAT_VERSION {
+            return Err(format!("compact basis version {version}, expected {FORMAT_VERSION}"));
+        }
+        if size == 0 || size > 4096 || n > INPUT_VALUES {
+            return Err(format!("{size} directions over {n} values is out of range"));
+        }
+        let expected = HEADER + 8 * n + 4 * size + 2 * n * size;
+        if bytes.len() != expected {
+            return Err(format!(
+                "{} bytes, but K = {size} over {n} values needs {expected}",
+                bytes.len()
+            ));
+        }
+        let mut at = HEADER;
+        let mut take = |len: usize| {
+            let part = &bytes[at..at + len];
+            at += len;
+            part
+        };
+        let words = |b: &[u8]| -> Vec<[u8; 4]> {
+            b.chunks_exact(4).map(|c| c.try_into().unwrap()).collect()
+        };
+        let support: Vec<u32> = words(take(4 * n)).into_iter().map(u32::from_le_bytes).collect();
+        let offset: Vec<f32> = words(take(4 * n)).into_iter().map(f32::from_le_bytes).collect();
+        let unscale: Vec<f32> = words(take(4 * size)).into_iter().map(f32::from_le_bytes).collect();
+        let values: Vec<f16> =
+            take(2 * n * size).chunks_exact(2).map(|c| f16::from_le_bytes([c[0], c[1]])).collect();
+        if support.windows(2).any(|w| w[0] >= w[1])
+            || support.last().is_some_and(|&v| v as usize >= INPUT_VALUES)
+        {
+            return Err("the support is not increasing within the layout".into());
+        }
+        if offset.iter().any(|v| !v.is_finite()) {
+            return Err("an offset value is not finite".into());
+        }
+        if unscale.iter().any(|v| !v.is_finite() || *v <= 0.0) {
+            return Err("a direction's scale is not a positive finite number".into());
+        }
+        if values.iter().any(|v| !v.is_finite()) {
+            return Err("a basis value is not finite".into());
+        }
+        Ok(Self { size, support, offset, values, unscale })
     }
 
     /// `c = U ((x - mu) * mask)`: the K coordinates of a mapped layout `input` with validity
@@ -237,6 +313,28 @@ mod tests {
         }
         // A zero mask gives zero coordinates.
         assert_eq!(compact.coefficients(&x, &vec![0f32; INPUT_VALUES]).unwrap(), vec![0.0; 2]);
+    }
+
+    #[test]
+    fn bytes_round_trip_and_damage_is_named() {
+        let (rows, offset) = basis();
+        let compact = CompactBasis::new(&rows, 2, &offset).unwrap();
+        let bytes = compact.to_bytes();
+        let back = CompactBasis::from_bytes(&bytes).unwrap();
+        assert_eq!(back.expand(&[0.3, 0.4]).unwrap(), compact.expand(&[0.3, 0.4]).unwrap());
+        let err = |b: &[u8]| CompactBasis::from_bytes(b).unwrap_err();
+        assert!(err(&bytes[..bytes.len() - 1]).contains("bytes"));
+        assert!(err(&bytes[..10]).contains("magic"));
+        let mut absurd = bytes.clone();
+        absurd[16..20].copy_from_slice(&u32::MAX.to_le_bytes());
+        assert!(err(&absurd).contains("out of range"));
+        let mut unsorted = bytes.clone();
+        unsorted[HEADER..HEADER + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+        assert!(err(&unsorted).contains("support"));
+        let mut nan = bytes.clone();
+        let last = nan.len() - 2;
+        nan[last..].copy_from_slice(&f16::NAN.to_le_bytes());
+        assert!(err(&nan).contains("not finite"));
     }
 
     #[test]

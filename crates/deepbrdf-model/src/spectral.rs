@@ -39,13 +39,15 @@ pub struct SpectralPath {
 impl SpectralPath {
     /// A path of `size` directions for latent dimension `latent`, with MLPs of width `hidden`
     /// (none without); hidden layers from `init`, the last ones at zero; the basis at zero
-    /// until [`with_basis`](Self::with_basis).
+    /// until [`with_basis`](Self::with_basis), or absent without `allocate_basis` (for a codec
+    /// that keeps the basis its own way).
     pub(crate) fn new(
         size: usize,
         latent: usize,
         hidden: Option<usize>,
         init: &Initializer,
         negative_slope: f64,
+        allocate_basis: bool,
         device: &Device,
     ) -> Self {
         let mlp = |from: usize, to: usize| -> Vec<Linear> {
@@ -56,10 +58,10 @@ impl SpectralPath {
             vec![layer(from, h, init), layer(h, h, init), layer(h, to, &Initializer::Zeros)]
         };
         Self {
-            basis: Some(
+            basis: allocate_basis.then(|| {
                 Param::from_tensor(Tensor::zeros([size, INPUT_VALUES], device))
-                    .set_require_grad(false),
-            ),
+                    .set_require_grad(false)
+            }),
             encoder: mlp(size, latent),
             decoder: mlp(latent, size),
             size,
