@@ -5,5 +5,6 @@ mod baselines;
 mod data;
 mod devices;
 mod fetch_merl;
+mod model;
 mod render;
 mod sweep_k;

@@ -2,21 +2,10 @@
 //! two-channel network trained for one epoch, k = 1 and 2. The second run must reuse the
 //! trained models (and so reproduce the first run's numbers exactly).
 use crate::util;
-use deepbrdf_data::merl::{write_merl, MerlTable};
+use deepbrdf_data::merl::write_merl;
 use deepbrdf_model::burn::config::Config as _;
 use deepbrdf_model::{AutoencoderConfig, TrainConfig};
 use std::path::Path;
-
-/// A diffuse colour plus a specular lobe in theta_h, varying with `i`.
-fn material(i: usize) -> MerlTable {
-    let diffuse = [0.05 + 0.04 * i as f32, 0.1, 0.2 - 0.03 * i as f32];
-    let width = 4.0 + 3.0 * i as f32;
-    MerlTable::from_fn(|h, d, p| {
-        let lobe = (1.0 + i as f32) * (-(h as f32 / width).powi(2)).exp();
-        let fresnel = 1.0 + 0.01 * d as f32 + 0.001 * (p as f32 / 10.0).sin();
-        diffuse.map(|c| c + lobe * fresnel)
-    })
-}
 
 fn tiny_config(path: &Path) {
     let model = AutoencoderConfig::new()
@@ -37,7 +26,7 @@ fn sweep_k_writes_results_and_reuses_trained_models() {
     let data = dir.path().join("data");
     std::fs::create_dir(&data).unwrap();
     for i in 0..3 {
-        write_merl(&material(i), data.join(format!("m{i}.binary"))).unwrap();
+        write_merl(&util::material(i), data.join(format!("m{i}.binary"))).unwrap();
     }
     let config = dir.path().join("tiny.json");
     tiny_config(&config);

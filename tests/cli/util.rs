@@ -1,6 +1,7 @@
 //! Shared helpers for CLI tests: run the binary, temporary directories.
 #![allow(dead_code)]
 
+use deepbrdf_data::merl::MerlTable;
 use std::path::Path;
 use std::process::{Command, Output};
 
@@ -35,4 +36,15 @@ pub fn assert_clean_failure(o: &Output, needle: &str) {
     assert!(!err.contains("panicked"), "the binary panicked: {err}");
     assert!(err.contains("error:"), "no error line: {err}");
     assert!(err.contains(needle), "error does not mention '{needle}': {err}");
+}
+
+/// A synthetic material: a diffuse colour plus a specular lobe in theta_h, varying with `i`.
+pub fn material(i: usize) -> MerlTable {
+    let diffuse = [0.05 + 0.04 * i as f32, 0.1, 0.2 - 0.03 * i as f32];
+    let width = 4.0 + 3.0 * i as f32;
+    MerlTable::from_fn(|h, d, p| {
+        let lobe = (1.0 + i as f32) * (-(h as f32 / width).powi(2)).exp();
+        let fresnel = 1.0 + 0.01 * d as f32 + 0.001 * (p as f32 / 10.0).sin();
+        diffuse.map(|c| c + lobe * fresnel)
+    })
 }

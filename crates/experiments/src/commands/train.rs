@@ -15,9 +15,10 @@ use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Latent dimension k (§3.2 studies 5 to 40).
-    #[arg(long, default_value_t = 10)]
-    pub k: usize,
+    /// Latent dimension k (§3.2 studies 5 to 40) [default: 10 with a preset, the file's with
+    /// --config].
+    #[arg(long)]
+    pub k: Option<usize>,
     /// cpu (sized for a 2-core CPU, see README) or paper (Table 1, lr 2e-5, batch 32,
     /// 1000 epochs: for GPUs).
     #[arg(long, default_value = "cpu", value_parser = parse_preset)]
@@ -34,9 +35,10 @@ pub struct Args {
     /// Initial learning rate (default: the preset's).
     #[arg(long)]
     pub lr: Option<f64>,
-    /// Seed of the initialisation, the shuffling and the augmentation.
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
+    /// Seed of the initialisation, the shuffling and the augmentation [default: 0 with a preset,
+    /// the file's with --config].
+    #[arg(long)]
+    pub seed: Option<u64>,
     /// Slice-dropout augmentation: the probability that an input loses phi_d slices (each
     /// missing one filled from its nearest kept one; the target stays whole).
     #[arg(long, value_name = "P")]
@@ -65,10 +67,10 @@ impl Args {
             Some(path) => TrainConfig::load(path).map_err(|e| {
                 anyhow::anyhow!("{}: not a training configuration: {e}", path.display())
             })?,
-            None => self.preset.train_config(self.k),
+            None => self.preset.train_config(self.k.unwrap_or(10)),
         };
-        if self.config.is_some() && self.k != config.model.latent {
-            config.model.latent = self.k;
+        if let Some(k) = self.k {
+            config.model.latent = k;
         }
         if let Some(e) = self.epochs {
             config.epochs = e;
@@ -79,7 +81,9 @@ impl Args {
         if let Some(lr) = self.lr {
             config.learning_rate = lr;
         }
-        config.seed = self.seed;
+        if let Some(seed) = self.seed {
+            config.seed = seed;
+        }
         if let Some(p) = self.slice_dropout {
             config.slice_dropout = Some(
                 SliceDropoutConfig::new()
