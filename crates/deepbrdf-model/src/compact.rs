@@ -229,22 +229,18 @@ impl CompactBasis {
         }
         let k = self.size;
         let c: Vec<f32> = coefficients.iter().zip(&self.unscale).map(|(c, u)| c * u).collect();
-        let mut compact = vec![0f32; self.support.len()];
-        compact
-            .par_chunks_mut(CHUNK)
-            .zip(self.values.par_chunks(CHUNK * k))
-            .zip(self.offset.par_chunks(CHUNK))
-            .for_each(|((out, values), offset)| {
-                let mut row = vec![0f32; k];
-                for ((o, group), &mu) in out.iter_mut().zip(values.chunks_exact(k)).zip(offset) {
-                    group.convert_to_f32_slice(&mut row);
-                    *o = mu + dot(&row, &c);
-                }
-            });
+        // Stretches of the layout in parallel, each with the support values that fall in it.
         let mut full = vec![0f32; INPUT_VALUES];
-        for (&v, x) in self.support.iter().zip(compact) {
-            full[v as usize] = x;
-        }
+        full.par_chunks_mut(CHUNK).enumerate().for_each(|(b, out)| {
+            let start = b * CHUNK;
+            let lo = self.support.partition_point(|&v| (v as usize) < start);
+            let hi = self.support.partition_point(|&v| (v as usize) < start + out.len());
+            let mut row = vec![0f32; k];
+            for i in lo..hi {
+                self.values[i * k..(i + 1) * k].convert_to_f32_slice(&mut row);
+                out[self.support[i] as usize - start] = self.offset[i] + dot(&row, &c);
+            }
+        });
         Ok(full)
     }
 }
