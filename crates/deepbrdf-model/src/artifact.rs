@@ -177,15 +177,9 @@ impl ModelArtifact {
         compact: bool,
     ) -> Result<Self> {
         let mut model = model.clone();
-        let basis = match config.spectral_basis {
-            Some(size) if compact && config.spectral_only() => {
-                let rows = model.take_basis()?;
-                let offset = model.offset().ok_or_else(|| {
-                    ModelError::Invalid("a spectral network without its offset".into())
-                })?;
-                Some(CompactBasis::new(&rows, size, &offset)?.to_bytes())
-            }
-            _ => None,
+        let basis = match compact && config.spectral_only() {
+            true => Some(model.take_compact_basis()?.to_bytes()),
+            false => None,
         };
         let weights = model
             .into_record()

@@ -22,6 +22,7 @@ use burn::prelude::*;
 use burn::tensor::activation::leaky_relu;
 use burn::tensor::{Distribution, TensorData};
 
+use crate::compact::CompactBasis;
 use crate::error::ModelError;
 use crate::spectral::SpectralPath;
 
@@ -443,14 +444,20 @@ impl Autoencoder {
         self.spectral.as_ref()
     }
 
-    /// Moves the spectral path's basis out ([`SpectralPath::take_basis`]); the network can then
-    /// no longer encode or decode by itself.
-    pub(crate) fn take_basis(&mut self) -> crate::error::Result<Vec<f32>> {
+    /// Moves the spectral path's basis out ([`SpectralPath::take_basis`]) as a
+    /// [`CompactBasis`] around the offset; the network can then no longer encode or decode by
+    /// itself, only run the coordinate-space MLPs.
+    pub(crate) fn take_compact_basis(&mut self) -> crate::error::Result<CompactBasis> {
         let path = self
             .spectral
             .as_mut()
             .ok_or_else(|| ModelError::Invalid("this configuration has no spectral path".into()))?;
-        path.take_basis()
+        let size = path.size();
+        let rows = path.take_basis()?;
+        let offset = self
+            .offset()
+            .ok_or_else(|| ModelError::Invalid("a spectral network without its offset".into()))?;
+        CompactBasis::new(&rows, size, &offset)
     }
 
     /// The latent dimension k.

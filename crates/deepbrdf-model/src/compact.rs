@@ -2,7 +2,7 @@
 //! layout values where some direction or the offset is non-zero: the MERL grid's valid cells,
 //! 76% of the layout) and stored in half precision, direction by direction scaled by a power of
 //! two so its largest value is near f16's top. `x_hat = mu + U^T c` and `c = U (x - mu)` then
-//! read 0.64 GB instead of the 1.7 GB of the f32 basis: decoding is bound by memory bandwidth.
+//! read 0.67 GB instead of the 1.7 GB of the f32 basis: decoding is bound by memory bandwidth.
 //!
 //! Rounding a value to f16 changes it by at most 2^-11 of itself (power-of-two scales are exact,
 //! and the scaling keeps values of a direction within f16's normal range down to 2^-29 of its
