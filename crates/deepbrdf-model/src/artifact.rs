@@ -110,6 +110,14 @@ struct Manifest {
     basis: Option<Part>,
 }
 
+/// The checksums of an artifact's parts, computed once (hashing a basis takes seconds).
+#[derive(Debug, Clone)]
+struct Parts {
+    weights: Part,
+    reference: Part,
+    basis: Option<Part>,
+}
+
 /// A trained model with its median reference and provenance, in memory.
 #[derive(Debug, Clone)]
 pub struct ModelArtifact {
@@ -119,6 +127,7 @@ pub struct ModelArtifact {
     /// A spectral-only network's basis, serialised compact ([`CompactBasis::to_bytes`]).
     basis: Option<Vec<u8>>,
     reference: MedianReference,
+    parts: Parts,
     id: String,
 }
 
@@ -186,14 +195,13 @@ impl ModelArtifact {
             .into_bytes()
             .map_err(|e| ModelError::Invalid(format!("cannot serialise the weights: {e}")))?
             .to_vec();
-        let mut artifact =
-            Self { config, provenance, weights, basis, reference, id: String::new() };
-        artifact.id = artifact.manifest_id(
-            &artifact.weights_part(),
-            &artifact.reference_part(),
-            artifact.basis_part().as_ref(),
-        );
-        Ok(artifact)
+        let parts = Parts {
+            weights: part_of(&weights, WEIGHTS_FILE),
+            reference: reference_part(&reference),
+            basis: basis.as_ref().map(|b| part_of(b, BASIS_FILE)),
+        };
+        let id = manifest_id(&config, &provenance, &parts);
+        Ok(Self { config, provenance, weights, basis, reference, parts, id })
     }
 
     /// The id tying configuration, provenance, weights and reference together.
@@ -285,9 +293,9 @@ impl ModelArtifact {
             id: self.id.clone(),
             config: self.config.clone(),
             provenance: self.provenance.clone(),
-            weights: self.weights_part(),
-            reference: self.reference_part(),
-            basis: self.basis_part(),
+            weights: self.parts.weights.clone(),
+            reference: self.parts.reference.clone(),
+            basis: self.parts.basis.clone(),
         };
         let json = serde_json::to_string_pretty(&manifest)
             .map_err(|e| ModelError::Invalid(format!("cannot serialise the manifest: {e}")))?;
@@ -340,70 +348,66 @@ impl ModelArtifact {
         };
         let reference_path = dir.join(REFERENCE_FILE);
         let reference = MedianReference::load(&reference_path)?;
-        let artifact = Self {
-            config: manifest.config,
-            provenance: manifest.provenance,
-            weights,
-            basis,
-            reference,
-            id: manifest.id,
-        };
-        if artifact.reference_part() != manifest.reference {
+        if reference_part(&reference) != manifest.reference {
             return Err(ModelError::mismatch(
                 &reference_path,
                 format!(
                     "this median reference does not belong to model {} (checksum differs)",
-                    artifact.id
+                    manifest.id
                 ),
             ));
         }
-        let expected =
-            artifact.manifest_id(&manifest.weights, &manifest.reference, manifest.basis.as_ref());
-        if expected != artifact.id {
+        let parts = Parts {
+            weights: manifest.weights,
+            reference: manifest.reference,
+            basis: manifest.basis,
+        };
+        if manifest_id(&manifest.config, &manifest.provenance, &parts) != manifest.id {
             return Err(ModelError::mismatch(
                 &manifest_path,
                 "the manifest was edited or damaged (its id does not match its content)",
             ));
         }
-        Ok(artifact)
+        Ok(Self {
+            config: manifest.config,
+            provenance: manifest.provenance,
+            weights,
+            basis,
+            reference,
+            parts,
+            id: manifest.id,
+        })
     }
+}
 
-    fn weights_part(&self) -> Part {
-        part_of(&self.weights, WEIGHTS_FILE)
+/// The reference's checksum is taken over its values (little-endian f32), not over the file,
+/// whose own format and checksum belong to `deepbrdf-data`.
+fn reference_part(reference: &MedianReference) -> Part {
+    let mut hasher = Sha256::new();
+    for v in reference.values() {
+        hasher.update(v.to_le_bytes());
     }
+    Part {
+        file: REFERENCE_FILE.into(),
+        bytes: 4 * reference.values().len() as u64,
+        sha256: hex::encode(hasher.finalize()),
+    }
+}
 
-    fn basis_part(&self) -> Option<Part> {
-        self.basis.as_ref().map(|b| part_of(b, BASIS_FILE))
+/// The id over configuration, provenance and the parts' checksums. A version 1 model (no
+/// basis part) keeps its id: the basis enters only when present.
+fn manifest_id(config: &AutoencoderConfig, provenance: &Provenance, parts: &Parts) -> String {
+    let mut content = serde_json::json!({
+        "config": config,
+        "provenance": provenance,
+        "weights": parts.weights,
+        "reference": parts.reference,
+    });
+    if let Some(basis) = &parts.basis {
+        content["basis"] = serde_json::json!(basis);
     }
-
-    /// The reference's checksum is taken over its values (little-endian f32), not over the
-    /// file, whose own format and checksum belong to `deepbrdf-data`.
-    fn reference_part(&self) -> Part {
-        let mut hasher = Sha256::new();
-        for v in self.reference.values() {
-            hasher.update(v.to_le_bytes());
-        }
-        Part {
-            file: REFERENCE_FILE.into(),
-            bytes: 4 * self.reference.values().len() as u64,
-            sha256: hex::encode(hasher.finalize()),
-        }
-    }
-
-    /// A version 1 model (no basis part) keeps its id: the basis enters only when present.
-    fn manifest_id(&self, weights: &Part, reference: &Part, basis: Option<&Part>) -> String {
-        let mut content = serde_json::json!({
-            "config": self.config,
-            "provenance": self.provenance,
-            "weights": weights,
-            "reference": reference,
-        });
-        if let Some(basis) = basis {
-            content["basis"] = serde_json::json!(basis);
-        }
-        let digest = Sha256::digest(canonical(content).to_string().as_bytes());
-        hex::encode(&digest[..16])
-    }
+    let digest = Sha256::digest(canonical(content).to_string().as_bytes());
+    hex::encode(&digest[..16])
 }
 
 /// Loads burnpack `weights` into `network`.

@@ -1,13 +1,13 @@
 //! Speed measurements of the networks, for `experiments bench model`: seconds per training step
 //! (forward, eq. (4) loss, backward, Adam) and seconds to decode a latent vector into a full
-//! MERL table (through the codec, [`DeepBrdf`]). Inputs are synthetic (random mapped values on the MERL grid's mask): speed does
-//! not depend on the values.
+//! MERL table (through the codec, [`DeepBrdf`]). Inputs are synthetic (random mapped values on
+//! the MERL grid's mask): speed does not depend on the values.
 
 use std::time::Instant;
 
 use burn::prelude::*;
 use burn::tensor::TensorData;
-use deepbrdf_data::layout::{from_layout, mask_layout};
+use deepbrdf_data::layout::mask_layout;
 use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::merl::VALUES;
 use rand::{Rng, SeedableRng};
@@ -136,50 +136,37 @@ pub fn decode(config: &AutoencoderConfig, repeats: usize, device: &Device) -> Re
         model = model.with_basis(&basis)?;
     }
     let latent: Vec<f32> = (0..config.latent).map(|i| 0.1 * (i as f32 - 2.0)).collect();
-    let f32_network = if config.spectral_only() {
-        let mut runs = Vec::new();
-        for run in 0..=repeats.max(1) {
-            let start = Instant::now();
-            let z = Tensor::<2>::from_data(
-                TensorData::new(latent.clone(), [1, config.latent]),
-                &device,
-            );
-            let out: Vec<f32> =
-                model.decode(z).into_data().try_into_vec().map_err(|e| {
+    let f32_network =
+        match config.spectral_only() {
+            true => Some(timed(repeats, || {
+                let z = Tensor::<2>::from_data(
+                    TensorData::new(latent.clone(), [1, config.latent]),
+                    &device,
+                );
+                model.decode(z).into_data().try_into_vec::<f32>().map_err(|e| {
                     ModelError::Invalid(format!("reading a tensor back failed: {e:?}"))
-                })?;
-            std::hint::black_box(out);
-            if run > 0 {
-                runs.push(start.elapsed().as_secs_f64());
-            }
-        }
-        Some(Timing { runs })
-    } else {
-        None
-    };
+                })
+            })?),
+            false => None,
+        };
     let provenance = Provenance::untrained("benchmark", 0);
     let reference = MedianReference::from_values(vec![0.05; VALUES])?;
     let artifact = ModelArtifact::new(config.clone(), provenance, &model, reference)?;
     drop(model);
     let codec = DeepBrdf::from_artifact(artifact, &device)?;
-    let mask = grid_mask();
-    let mut network = Vec::new();
-    let mut whole = Vec::new();
-    for run in 0..=repeats.max(1) {
+    let network = timed(repeats, || codec.decode_layout(&latent))?;
+    let whole = timed(repeats, || codec.decode(&latent))?;
+    Ok(DecodeTiming { network, whole, f32_network })
+}
+
+/// Times `repeats` runs of `f` (at least one) after one untimed warm-up.
+fn timed<T>(repeats: usize, mut f: impl FnMut() -> Result<T>) -> Result<Timing> {
+    std::hint::black_box(f()?);
+    let mut runs = Vec::with_capacity(repeats.max(1));
+    for _ in 0..repeats.max(1) {
         let start = Instant::now();
-        let out = codec.decode_layout(&latent)?;
-        let net = start.elapsed().as_secs_f64();
-        let table = codec.reference().unmap(&from_layout(&out), &mask)?;
-        let total = start.elapsed().as_secs_f64();
-        std::hint::black_box(table);
-        if run > 0 {
-            network.push(net);
-            whole.push(total);
-        }
+        std::hint::black_box(f()?);
+        runs.push(start.elapsed().as_secs_f64());
     }
-    Ok(DecodeTiming {
-        network: Timing { runs: network },
-        whole: Timing { runs: whole },
-        f32_network,
-    })
+    Ok(Timing { runs })
 }

@@ -310,7 +310,6 @@ fn run(
     };
     // Without convolutions, training runs on the coordinates alone (see `crate::spectral`).
     let coefficients = spectral.filter(|_| config.model.spectral_only());
-
     let pretty = serde_json::to_string_pretty(&config_json).unwrap_or_default();
     write_atomic(&out_dir.join(CONFIG_FILE), &[pretty.as_bytes(), b"\n"])?;
 
