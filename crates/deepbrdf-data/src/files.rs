@@ -41,7 +41,7 @@ pub(crate) fn read_exactly(file: &mut File, path: &Path, len: usize) -> Result<V
 /// Writes `bytes` to `path` atomically: a temporary file in the same directory is written,
 /// flushed to disk and renamed over `path`. On failure `path` is untouched and the temporary file
 /// is removed.
-pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),

@@ -5,7 +5,7 @@ pub mod cache;
 pub mod dataset;
 pub mod error;
 pub mod fetch;
-mod files;
+pub mod files;
 pub mod layout;
 pub mod mapping;
 pub mod merl;

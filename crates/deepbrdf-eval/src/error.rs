@@ -11,6 +11,9 @@ pub enum EvalError {
     /// An error of the data layer (reading tables, the median reference, ...).
     #[error(transparent)]
     Data(#[from] deepbrdf_data::DataError),
+    /// An error of the renderer (image-space measures, figures).
+    #[error(transparent)]
+    Render(#[from] deepbrdf_render::RenderError),
     /// An operating-system error on a named path.
     #[error("{path}: {source}")]
     Io {

@@ -7,8 +7,5 @@ pub mod harness;
 pub mod ipca;
 pub mod metrics;
 pub mod pca;
-pub mod render;
-#[cfg(test)]
-mod testing;
 
 pub use error::{EvalError, Result};

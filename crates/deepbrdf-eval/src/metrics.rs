@@ -4,11 +4,11 @@
 //! MERL table and its reconstruction on a fixed scene.
 
 use crate::error::{EvalError, Result};
-use crate::render::image::false_colour;
-use crate::render::{
+use deepbrdf_data::{MerlTable, Silent};
+use deepbrdf_render::image::false_colour;
+use deepbrdf_render::{
     render, Image, MerlBrdf, RenderSettings, Scene, SceneConfig, Srgb8Image, Tonemap,
 };
-use deepbrdf_data::{MerlTable, Silent};
 use serde::{Deserialize, Serialize};
 
 fn check_same_size(a: &Image, b: &Image) -> Result<()> {
@@ -149,7 +149,7 @@ impl Default for ImageRelaeConfig {
 pub struct ImageRelae {
     scene: Scene,
     config: ImageRelaeConfig,
-    lobe: crate::render::SamplingLobe,
+    lobe: deepbrdf_render::SamplingLobe,
     reference: Image,
 }
 
@@ -170,7 +170,7 @@ impl ImageRelae {
     /// Renders `reconstruction` like the original.
     pub fn render(&self, reconstruction: &MerlTable) -> Result<Image> {
         let brdf = MerlBrdf::new(reconstruction).with_lobe(self.lobe);
-        render(&self.scene, &brdf, &self.config.render, &Silent)
+        Ok(render(&self.scene, &brdf, &self.config.render, &Silent)?)
     }
 
     /// RelAE of `reconstruction`'s render against the original's.
@@ -241,7 +241,7 @@ mod tests {
 #[cfg(test)]
 mod image_relae_tests {
     use super::*;
-    use crate::testing::synthetic_table;
+    use deepbrdf_data::testing::synthetic_table;
 
     #[test]
     fn noise_cancels_between_original_and_reconstruction() {

@@ -5,9 +5,9 @@
 use deepbrdf_data::augment::{kept_slices, SliceSelection};
 use deepbrdf_data::merl::{cell_index, CELLS, N_THETA_D, N_THETA_H};
 use deepbrdf_data::MerlTable;
-use deepbrdf_eval::render::image::false_colour;
-use deepbrdf_eval::render::{contact_sheet, SheetConfig, Srgb8Image, Tile};
 use deepbrdf_model::DeepBrdf;
+use deepbrdf_render::image::false_colour;
+use deepbrdf_render::{contact_sheet, SheetConfig, Srgb8Image, Tile};
 use std::path::Path;
 
 /// The BRDF the paper shows in Fig. 2.

@@ -3,8 +3,10 @@
 //! theta_h = (i / 90)^2 * pi/2 (MERL's square-root warp), theta_d = j / 90 * pi/2,
 //! phi_d = k / 180 * pi.
 
-use super::table::{N_PHI_D, N_THETA_D, N_THETA_H};
+use super::table::{cell_coords, CELLS, N_PHI_D, N_THETA_D, N_THETA_H};
+use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI};
+use std::sync::OnceLock;
 
 /// theta_h (radians) of index `i`: the inverse of MERL's square-root warp.
 #[inline]
@@ -41,4 +43,20 @@ pub fn angles_are_valid(theta_h: f64, theta_d: f64, phi_d: f64) -> bool {
 #[inline]
 pub fn cell_is_valid(i: usize, j: usize, k: usize) -> bool {
     angles_are_valid(theta_h_of(i), theta_d_of(j), phi_d_of(k))
+}
+
+/// [`cell_is_valid`] of every cell in MERL order, evaluated once per process: the grid's
+/// validity mask (the one home of this fact; tabulation, the baselines' domain and the codec use
+/// it).
+pub fn valid_mask() -> &'static [bool] {
+    static MASK: OnceLock<Vec<bool>> = OnceLock::new();
+    MASK.get_or_init(|| {
+        (0..CELLS)
+            .into_par_iter()
+            .map(|c| {
+                let (h, d, p) = cell_coords(c);
+                cell_is_valid(h, d, p)
+            })
+            .collect()
+    })
 }

@@ -10,27 +10,13 @@
 //! coefficients). Decoded tables are valid exactly on the domain.
 
 use crate::error::{EvalError, Result};
-use deepbrdf_data::merl::{cell_coords, grid, CELLS};
+use deepbrdf_data::merl::grid::valid_mask;
+use deepbrdf_data::merl::CELLS;
 use deepbrdf_data::MerlTable;
 use rayon::prelude::*;
-use std::sync::OnceLock;
 
 /// Cells per parallel work item.
 const CHUNK: usize = 16 * 1024;
-
-/// [`grid::cell_is_valid`] of every cell, evaluated once per process.
-pub fn grid_mask() -> &'static [bool] {
-    static MASK: OnceLock<Vec<bool>> = OnceLock::new();
-    MASK.get_or_init(|| {
-        (0..CELLS)
-            .into_par_iter()
-            .map(|c| {
-                let (h, d, p) = cell_coords(c);
-                grid::cell_is_valid(h, d, p)
-            })
-            .collect()
-    })
-}
 
 /// Valid cells shared by a set of tables, in increasing MERL order.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -39,9 +25,9 @@ pub struct Domain {
 }
 
 impl Domain {
-    /// Cells valid in all `tables` and on the grid ([`grid::cell_is_valid`]).
+    /// Cells valid in all `tables` and on the grid ([`deepbrdf_data::merl::grid::cell_is_valid`]).
     pub fn common(tables: &[&MerlTable]) -> Result<Self> {
-        let grid = grid_mask();
+        let grid = valid_mask();
         let cells: Vec<u32> = grid
             .par_chunks(CHUNK)
             .enumerate()

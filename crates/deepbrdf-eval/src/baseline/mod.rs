@@ -5,7 +5,7 @@ mod artifact;
 mod domain;
 mod mapping;
 
-pub use domain::{grid_mask, Domain};
+pub use domain::Domain;
 pub use mapping::{Mapping, MappingKind};
 
 use crate::error::{EvalError, Result};
@@ -285,8 +285,8 @@ fn max_k(ks: &[usize]) -> Result<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testing::{sparse_set, synthetic_set};
     use deepbrdf_data::merl::CELLS;
+    use deepbrdf_data::testing::{sparse_set, synthetic_set};
     use deepbrdf_data::Silent;
 
     /// Largest |rho - rho_hat| cos_i cos_o over the domain.

@@ -191,7 +191,7 @@ impl Yardstick {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testing::synthetic_table;
+    use deepbrdf_data::testing::synthetic_table;
 
     #[test]
     fn measures_match_their_definitions_written_out() {

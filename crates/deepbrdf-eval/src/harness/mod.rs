@@ -221,7 +221,7 @@ pub fn run(
 mod tests {
     use super::*;
     use crate::baseline::BaselineMethod;
-    use crate::testing::sparse_set;
+    use deepbrdf_data::testing::sparse_set;
     use deepbrdf_data::Silent;
     use std::sync::Mutex;
 

@@ -7,7 +7,7 @@ use anyhow::Context;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::Progress;
 use deepbrdf_eval::metrics::{compare_images, difference_image};
-use deepbrdf_eval::render::{render, MerlBrdf};
+use deepbrdf_render::{render, MerlBrdf};
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]

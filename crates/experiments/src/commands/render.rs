@@ -5,7 +5,7 @@ use crate::scene_args::SceneArgs;
 use anyhow::Context;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::Progress;
-use deepbrdf_eval::render::{render, MerlBrdf};
+use deepbrdf_render::{render, MerlBrdf};
 use std::path::PathBuf;
 use std::time::Instant;
 

@@ -4,7 +4,7 @@ use crate::data_args::DataArgs;
 use crate::scene_args::SceneArgs;
 use deepbrdf_data::Progress;
 use deepbrdf_data::Silent;
-use deepbrdf_eval::render::{contact_sheet, render, MerlBrdf, SheetConfig, Tile};
+use deepbrdf_render::{contact_sheet, render, MerlBrdf, SheetConfig, Tile};
 use std::path::PathBuf;
 use std::time::Instant;
 

@@ -1,7 +1,7 @@
 //! The sum of two BRDFs (e.g. a Lambertian base plus a GGX lobe), sampled as a mixture.
 
 use super::{Brdf, Ggx, Lambertian, Rgb};
-use crate::render::geometry::Vec3;
+use crate::geometry::Vec3;
 
 /// `f = a + b`; `sample` picks `a` with probability `prob_a`, and `pdf` is the mixture density.
 pub struct Sum<A, B> {
@@ -50,7 +50,7 @@ impl<A: Brdf, B: Brdf> Brdf for Sum<A, B> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::brdf::tests::check_sampling;
+    use crate::brdf::tests::check_sampling;
 
     #[test]
     fn sum_adds_and_samples_as_mixture() {

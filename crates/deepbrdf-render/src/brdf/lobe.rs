@@ -7,7 +7,7 @@
 //! pdf.
 
 use super::{cosine_hemisphere_pdf, sample_cosine_hemisphere, Ggx};
-use crate::render::geometry::Vec3;
+use crate::geometry::Vec3;
 use deepbrdf_data::merl::{grid, N_THETA_H};
 use deepbrdf_data::MerlTable;
 use std::f64::consts::PI;
@@ -158,8 +158,8 @@ mod tests {
         assert!((lobe.alpha / 0.005 - 1.0).abs() < 0.3, "{lobe:?}");
         assert!(lobe.halo_alpha > 4.0 * lobe.alpha, "{lobe:?}");
         struct Proxy(SamplingLobe);
-        impl crate::render::brdf::Brdf for Proxy {
-            fn eval(&self, wi: Vec3, wo: Vec3) -> crate::render::brdf::Rgb {
+        impl crate::brdf::Brdf for Proxy {
+            fn eval(&self, wi: Vec3, wo: Vec3) -> crate::brdf::Rgb {
                 [Ggx::reflected_pdf(0.3, wi, wo) + 0.1; 3]
             }
             fn sample(&self, wo: Vec3, u: [f64; 2]) -> Option<Vec3> {
@@ -170,7 +170,7 @@ mod tests {
             }
         }
         let mixed = SamplingLobe { alpha: 0.1, halo_alpha: 0.4, specular_prob: 0.6 };
-        let (s, u) = crate::render::brdf::tests::check_sampling(
+        let (s, u) = crate::brdf::tests::check_sampling(
             &Proxy(mixed),
             Vec3::from_spherical(0.5, 0.0),
             100_000,

@@ -7,9 +7,9 @@
 //! covers a quarter of the grid, so harness tests run several times faster on the same code
 //! paths (a domain smaller than the grid is a supported case: see `baseline::Domain`).
 
-use crate::baseline::grid_mask;
-use deepbrdf_data::merl::{cell_coords, grid, CELLS, INVALID_VALUE, N_PHI_D, N_THETA_D, VALUES};
-use deepbrdf_data::MerlTable;
+use crate::merl::grid::valid_mask;
+use crate::merl::{cell_coords, grid, CELLS, INVALID_VALUE, N_PHI_D, N_THETA_D, VALUES};
+use crate::MerlTable;
 use rayon::prelude::*;
 use std::sync::{Mutex, OnceLock};
 
@@ -19,7 +19,7 @@ fn build(i: usize) -> MerlTable {
     let albedo = [0.2 + 0.07 * f, 0.5 - 0.05 * (f % 4.0), 0.1 + 0.1 * (f % 3.0)];
     let strength = 0.5 + 3.0 * ((f * 0.7).sin().abs());
     let width = 0.05 + 0.04 * (f % 5.0);
-    let mask = grid_mask();
+    let mask = valid_mask();
     let mut values = vec![INVALID_VALUE; VALUES];
     let (r, rest) = values.split_at_mut(CELLS);
     let (g, b) = rest.split_at_mut(CELLS);

@@ -5,7 +5,7 @@
 use super::brdf::Rgb;
 use super::geometry::Vec3;
 use super::sky::{SunSky, SunSkyConfig};
-use crate::error::{EvalError, Result};
+use crate::error::{RenderError, Result};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 use std::fmt;
@@ -130,7 +130,7 @@ impl LightSpec {
             },
             Self::Directional { theta_deg, phi_deg } => {
                 if !(theta_deg.is_finite() && phi_deg.is_finite()) {
-                    return Err(EvalError::Invalid(format!(
+                    return Err(RenderError::Invalid(format!(
                         "light direction {self} is not finite"
                     )));
                 }
@@ -147,7 +147,7 @@ impl LightSpec {
             }
             Self::Constant { radiance } => {
                 if !(radiance.is_finite() && radiance >= 0.0) {
-                    return Err(EvalError::Invalid(format!(
+                    return Err(RenderError::Invalid(format!(
                         "constant radiance {radiance} must be finite and >= 0"
                     )));
                 }
@@ -177,7 +177,7 @@ fn parse_numbers(spec: &str, list: &str, min: usize, max: usize) -> Result<Vec<f
         list.split(',').map(|s| s.trim().parse::<f64>()).collect();
     match values {
         Ok(v) if (min..=max).contains(&v.len()) && v.iter().all(|x| x.is_finite()) => Ok(v),
-        _ => Err(EvalError::Invalid(format!(
+        _ => Err(RenderError::Invalid(format!(
             "light '{spec}': expected {min}{} finite numbers separated by commas",
             if max > min { format!(" to {max}") } else { String::new() }
         ))),
@@ -185,7 +185,7 @@ fn parse_numbers(spec: &str, list: &str, min: usize, max: usize) -> Result<Vec<f
 }
 
 impl FromStr for LightSpec {
-    type Err = EvalError;
+    type Err = RenderError;
     fn from_str(spec: &str) -> Result<Self> {
         let (kind, rest) = spec.split_once(':').unwrap_or((spec, ""));
         match kind {
@@ -203,7 +203,7 @@ impl FromStr for LightSpec {
             }
             "const" if rest.is_empty() => Ok(Self::Constant { radiance: 1.0 }),
             "const" => Ok(Self::Constant { radiance: parse_numbers(spec, rest, 1, 1)?[0] }),
-            _ => Err(EvalError::Invalid(format!(
+            _ => Err(RenderError::Invalid(format!(
                 "light '{spec}': expected sun:ELEV,AZIM[,TURBIDITY], dir:THETA,PHI or const[:L]"
             ))),
         }

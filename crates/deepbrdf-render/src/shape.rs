@@ -5,7 +5,7 @@
 //! sphere of radius about 1.
 
 use super::geometry::{Ray, Vec3};
-use crate::error::{EvalError, Result};
+use crate::error::{RenderError, Result};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
@@ -51,7 +51,7 @@ impl Default for Shape {
 }
 
 impl FromStr for Shape {
-    type Err = EvalError;
+    type Err = RenderError;
     /// The default shape of a name in [`SHAPE_NAMES`].
     fn from_str(s: &str) -> Result<Self> {
         Ok(match s {
@@ -61,7 +61,7 @@ impl FromStr for Shape {
             "ellipsoid" => Self::Ellipsoid { radii: [0.75, 1.0, 0.55] },
             "cylinder" => Self::Cylinder { radius: 0.55, half_height: 0.8 },
             _ => {
-                return Err(EvalError::Invalid(format!(
+                return Err(RenderError::Invalid(format!(
                     "unknown shape '{s}' (expected one of {})",
                     SHAPE_NAMES.join(", ")
                 )))
@@ -120,7 +120,7 @@ impl Shape {
         if dims.iter().all(|d| d.is_finite() && *d > 0.0) {
             Ok(())
         } else {
-            Err(EvalError::Invalid(format!(
+            Err(RenderError::Invalid(format!(
                 "{self:?}: dimensions must be positive and finite (torus: major > minor)"
             )))
         }

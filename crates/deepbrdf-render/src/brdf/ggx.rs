@@ -3,7 +3,7 @@
 //! `f = D(h) G(wi, wo) F(wi.h) / (4 cos(theta_i) cos(theta_o))`.
 
 use super::{Brdf, Rgb};
-use crate::render::geometry::Vec3;
+use crate::geometry::Vec3;
 use std::f64::consts::PI;
 
 /// GGX lobe of roughness `alpha` and normal-incidence reflectance `f0` per channel.
@@ -93,7 +93,7 @@ impl Brdf for Ggx {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::brdf::tests::check_sampling;
+    use crate::brdf::tests::check_sampling;
 
     #[test]
     fn distribution_is_normalised() {

@@ -5,7 +5,7 @@
 
 use super::interleaved::InterleavedTable;
 use super::{Brdf, Rgb, SamplingLobe};
-use crate::render::geometry::Vec3;
+use crate::geometry::Vec3;
 use deepbrdf_data::MerlTable;
 use std::sync::Arc;
 
@@ -103,10 +103,10 @@ impl Brdf for MerlBrdf<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::brdf::{Ggx, Lambertian, Sum};
-    use crate::render::light::LightSpec;
-    use crate::render::scene::SceneConfig;
-    use crate::render::{render, RenderSettings};
+    use crate::brdf::{Ggx, Lambertian, Sum};
+    use crate::light::LightSpec;
+    use crate::scene::SceneConfig;
+    use crate::{render, RenderSettings};
     use deepbrdf_data::merl::coords::HalfDiff;
     use deepbrdf_data::merl::grid;
     use deepbrdf_data::Silent;
@@ -142,7 +142,7 @@ mod tests {
         })
     }
 
-    fn relae(a: &crate::render::Image, b: &crate::render::Image) -> f64 {
+    fn relae(a: &crate::Image, b: &crate::Image) -> f64 {
         let (mut num, mut den) = (0.0, 0.0);
         for (p, q) in a.pixels().iter().zip(b.pixels()) {
             for c in 0..3 {

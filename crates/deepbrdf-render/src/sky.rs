@@ -9,7 +9,7 @@
 use super::brdf::Rgb;
 use super::distribution::Distribution2D;
 use super::geometry::{Frame, Vec3};
-use crate::error::{EvalError, Result};
+use crate::error::{RenderError, Result};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
@@ -204,25 +204,25 @@ impl SunSky {
     pub fn new(config: SunSkyConfig) -> Result<Self> {
         let c = config;
         if !(c.elevation_deg > 0.0 && c.elevation_deg <= 90.0) {
-            return Err(EvalError::Invalid(format!(
+            return Err(RenderError::Invalid(format!(
                 "sun elevation {} deg is outside (0, 90]",
                 c.elevation_deg
             )));
         }
         if !(1.7..=10.0).contains(&c.turbidity) {
-            return Err(EvalError::Invalid(format!(
+            return Err(RenderError::Invalid(format!(
                 "turbidity {} is outside [1.7, 10], the range of Preetham's fit",
                 c.turbidity
             )));
         }
         if !(c.sun_radius_deg > 0.0 && c.sun_radius_deg <= 10.0) || !c.azimuth_deg.is_finite() {
-            return Err(EvalError::Invalid(format!(
+            return Err(RenderError::Invalid(format!(
                 "sun radius {} deg must be in (0, 10] and the azimuth finite",
                 c.sun_radius_deg
             )));
         }
         if !(8..=8192).contains(&c.map_width) || c.map_width % 4 != 0 {
-            return Err(EvalError::Invalid(format!(
+            return Err(RenderError::Invalid(format!(
                 "sky map width {} not in 8..=8192",
                 c.map_width
             )));
@@ -262,7 +262,7 @@ impl SunSky {
 
         let scale = PI / (sun_irradiance + sky_facing);
         if !scale.is_finite() || scale <= 0.0 {
-            return Err(EvalError::Invalid(format!("sun and sky of {c:?} carry no light")));
+            return Err(RenderError::Invalid(format!("sun and sky of {c:?} carry no light")));
         }
         let sun_prob = (sun_irradiance / (sun_irradiance + sky_power)).clamp(0.1, 0.9);
         let distribution = Distribution2D::new(&weight, width, height);

@@ -1,7 +1,7 @@
 //! The Lambertian (ideal diffuse) BRDF, `rho / pi`.
 
 use super::{Brdf, Rgb};
-use crate::render::geometry::Vec3;
+use crate::geometry::Vec3;
 use std::f64::consts::FRAC_1_PI;
 
 /// Ideal diffuse reflection of albedo `rho` per channel: `f = rho / pi`.

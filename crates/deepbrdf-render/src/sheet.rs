@@ -3,7 +3,7 @@
 //! look the same on machines without fonts.
 
 use super::image::Srgb8Image;
-use crate::error::{EvalError, Result};
+use crate::error::{RenderError, Result};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::sync::OnceLock;
@@ -55,7 +55,7 @@ fn register_font() -> Result<()> {
     if ok {
         Ok(())
     } else {
-        Err(EvalError::Invalid("the embedded DejaVu Sans font could not be loaded".into()))
+        Err(RenderError::Invalid("the embedded DejaVu Sans font could not be loaded".into()))
     }
 }
 
@@ -63,10 +63,10 @@ fn register_font() -> Result<()> {
 pub fn contact_sheet(tiles: &[Tile], config: &SheetConfig) -> Result<Srgb8Image> {
     let first = tiles
         .first()
-        .ok_or_else(|| EvalError::Invalid("a contact sheet needs at least one tile".into()))?;
+        .ok_or_else(|| RenderError::Invalid("a contact sheet needs at least one tile".into()))?;
     let (tw, th) = (first.image.width, first.image.height);
     if let Some(t) = tiles.iter().find(|t| (t.image.width, t.image.height) != (tw, th)) {
-        return Err(EvalError::Invalid(format!(
+        return Err(RenderError::Invalid(format!(
             "tile '{}' is {}x{}, the first is {tw}x{th}",
             t.caption, t.image.width, t.image.height
         )));
@@ -82,7 +82,7 @@ pub fn contact_sheet(tiles: &[Tile], config: &SheetConfig) -> Result<Srgb8Image>
     let (cell_w, cell_h) = (tw + config.gap, th + config.caption_height + config.gap);
     let (width, height) = (columns * cell_w + config.gap, rows * cell_h + config.gap);
     if u64::from(width) * u64::from(height) > 1 << 28 {
-        return Err(EvalError::Invalid(format!(
+        return Err(RenderError::Invalid(format!(
             "contact sheet of {width}x{height} pixels is too large"
         )));
     }
@@ -96,7 +96,7 @@ pub fn contact_sheet(tiles: &[Tile], config: &SheetConfig) -> Result<Srgb8Image>
     {
         let root = BitMapBackend::with_buffer(&mut sheet.data, (width, height)).into_drawing_area();
         let colour = RGBColor(config.text[0], config.text[1], config.text[2]);
-        let draw_err = |e: String| EvalError::Invalid(format!("drawing captions: {e}"));
+        let draw_err = |e: String| RenderError::Invalid(format!("drawing captions: {e}"));
         for (i, tile) in tiles.iter().enumerate() {
             let (x, y) = origin(i as u32);
             let (text, size) =

@@ -12,7 +12,7 @@ use super::brdf::{Brdf, Rgb};
 use super::geometry::{Frame, Vec3};
 use super::image::Image;
 use super::scene::Scene;
-use crate::error::{EvalError, Result};
+use crate::error::{RenderError, Result};
 use deepbrdf_data::Progress;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -51,7 +51,7 @@ impl RenderSettings {
     /// Checks the settings are in range.
     pub fn validate(&self) -> Result<()> {
         if !(1..=MAX_SIZE).contains(&self.size) || !(1..=MAX_SPP).contains(&self.spp) {
-            return Err(EvalError::Invalid(format!(
+            return Err(RenderError::Invalid(format!(
                 "image size {} must be in 1..={MAX_SIZE} and samples per pixel {} in 1..={MAX_SPP}",
                 self.size, self.spp
             )));
@@ -188,11 +188,11 @@ fn shade(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::brdf::{Lambertian, Sum};
-    use crate::render::camera::Projection;
-    use crate::render::light::{DirectionalLight, Environment, LightSpec, Lighting};
-    use crate::render::scene::SceneConfig;
-    use crate::render::shape::Shape;
+    use crate::brdf::{Lambertian, Sum};
+    use crate::camera::Projection;
+    use crate::light::{DirectionalLight, Environment, LightSpec, Lighting};
+    use crate::scene::SceneConfig;
+    use crate::shape::Shape;
     use deepbrdf_data::Silent;
     use std::f64::consts::PI;
 

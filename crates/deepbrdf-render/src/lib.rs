@@ -1,4 +1,4 @@
-//! A physically based renderer of measured BRDFs, for the paper's image-space evaluation
+//! `deepbrdf-render`: a physically based renderer of measured BRDFs, for the paper's image-space evaluation
 //! (RelAE, Figs. 4, 6-9) and its synthetic recovery training set (§5.2: objects under sun-and-sky
 //! lighting). Direct illumination of one analytic shape at the origin; see [`integrator`] for the
 //! estimator.
@@ -11,6 +11,7 @@
 pub mod brdf;
 pub mod camera;
 pub mod distribution;
+pub mod error;
 pub mod geometry;
 pub mod image;
 pub mod integrator;
@@ -22,6 +23,7 @@ pub mod sky;
 
 pub use brdf::{Brdf, Ggx, Lambertian, MerlBrdf, MerlLookup, SamplingLobe, Sum};
 pub use camera::{Camera, Projection};
+pub use error::{RenderError, Result};
 pub use image::{Image, Srgb8Image, Tonemap};
 pub use integrator::{render, RenderSettings};
 pub use light::{DirectionalLight, Environment, LightSpec, Lighting};

@@ -6,7 +6,7 @@
 //! counts from the top-left corner.
 
 use super::geometry::{Ray, Vec3};
-use crate::error::{EvalError, Result};
+use crate::error::{RenderError, Result};
 use serde::{Deserialize, Serialize};
 
 /// How the camera projects.
@@ -41,7 +41,7 @@ impl Camera {
     /// around the origin with a small margin.
     pub fn new(projection: Projection, theta_deg: f64, phi_deg: f64, extent: f64) -> Result<Self> {
         if !(theta_deg.is_finite() && phi_deg.is_finite() && extent.is_finite() && extent > 0.0) {
-            return Err(EvalError::Invalid(format!(
+            return Err(RenderError::Invalid(format!(
                 "view ({theta_deg}, {phi_deg}) deg with extent {extent}: must be finite"
             )));
         }
@@ -59,7 +59,7 @@ impl Camera {
             Projection::Orthographic => (framed, 2.0 * framed + 1.0),
             Projection::Perspective { fov_deg } => {
                 if !(fov_deg > 0.1 && fov_deg < 170.0) {
-                    return Err(EvalError::Invalid(format!(
+                    return Err(RenderError::Invalid(format!(
                         "field of view {fov_deg} deg not in (0.1, 170)"
                     )));
                 }

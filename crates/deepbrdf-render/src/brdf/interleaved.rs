@@ -140,8 +140,8 @@ impl InterleavedTable {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testing::synthetic_table;
     use deepbrdf_data::merl::coords::direction;
+    use deepbrdf_data::testing::synthetic_table;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 

@@ -2,8 +2,7 @@
 //! coverage as alpha) or tonemapped to 8-bit sRGB PNG (the `image` crate). Every file is written
 //! to a temporary file beside its target and renamed into place.
 
-use crate::error::{EvalError, Result};
-use crate::figures::write_atomic_file;
+use crate::error::{RenderError, Result};
 use std::path::Path;
 
 /// A linear-radiance RGB image (f32) with per-pixel coverage in [0, 1].
@@ -31,7 +30,7 @@ impl Image {
     ) -> Result<Self> {
         let n = width as usize * height as usize;
         if rgb.len() != n || coverage.len() != n {
-            return Err(EvalError::Invalid(format!(
+            return Err(RenderError::Invalid(format!(
                 "a {width}x{height} image needs {n} pixels, got {} and {} coverage values",
                 rgb.len(),
                 coverage.len()
@@ -99,8 +98,8 @@ impl Image {
         image
             .write()
             .to_buffered(&mut bytes)
-            .map_err(|e| EvalError::format(path, format!("cannot encode EXR: {e}")))?;
-        write_atomic_file(path, bytes.get_ref())
+            .map_err(|e| RenderError::format(path, format!("cannot encode EXR: {e}")))?;
+        Ok(deepbrdf_data::files::write_atomic(path, bytes.get_ref())?)
     }
 
     /// Reads an OpenEXR file written by [`Image::write_exr`] (or any RGB(A) EXR; missing alpha
@@ -117,12 +116,12 @@ impl Image {
                 pixels[pos.y() * *w + pos.x()] = [r, g, b, a];
             },
         )
-        .map_err(|e| EvalError::format(path, format!("not a readable RGB EXR image: {e}")))?;
+        .map_err(|e| RenderError::format(path, format!("not a readable RGB EXR image: {e}")))?;
         let size = image.layer_data.size;
         let (_, pixels) = image.layer_data.channel_data.pixels;
         let (w, h) = (u32::try_from(size.width()), u32::try_from(size.height()));
         let (Ok(w), Ok(h)) = (w, h) else {
-            return Err(EvalError::format(path, "image too large"));
+            return Err(RenderError::format(path, "image too large"));
         };
         let rgb = pixels.iter().map(|p| [p[0], p[1], p[2]]).collect();
         let coverage = pixels.iter().map(|p| p[3]).collect();
@@ -218,11 +217,11 @@ impl Srgb8Image {
     /// Encodes as PNG and writes it atomically.
     pub fn write_png(&self, path: &Path) -> Result<()> {
         let img = image::RgbImage::from_raw(self.width, self.height, self.data.clone())
-            .ok_or_else(|| EvalError::Invalid("image buffer has the wrong size".into()))?;
+            .ok_or_else(|| RenderError::Invalid("image buffer has the wrong size".into()))?;
         let mut png = Vec::new();
         img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-            .map_err(|e| EvalError::format(path, format!("cannot encode PNG: {e}")))?;
-        write_atomic_file(path, &png)
+            .map_err(|e| RenderError::format(path, format!("cannot encode PNG: {e}")))?;
+        Ok(deepbrdf_data::files::write_atomic(path, &png)?)
     }
 }
 
