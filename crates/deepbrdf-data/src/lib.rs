@@ -10,6 +10,7 @@ pub mod layout;
 pub mod mapping;
 pub mod merl;
 pub mod nbrdf;
+pub mod network_input;
 pub mod progress;
 pub mod summary;
 pub mod testing;

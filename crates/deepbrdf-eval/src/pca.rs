@@ -2,9 +2,9 @@
 //! `A - mu = U Sigma V^T`, truncated to the first k terms, with one BRDF per row of `A`.
 //!
 //! [`LinearBasis`] is the linear algebra on plain rows of any length (so it can be tested on
-//! small synthetic data); [`Pca`] is the paper's "traditional PCA" on MERL tables: the natural
+//! small synthetic data); the paper's "traditional PCA" on MERL tables: the natural
 //! logarithm of the reflectance ([`LOG_EPSILON`] added), all three channels in one row, over the
-//! valid cells (see [`crate::baseline::Domain`]).
+//! valid cells, is this basis fitted by the baselines' `BaselineMethod::pca`.
 //!
 //! The fit never forms the `d x d` covariance (d = 4,374,000 for a MERL table). With n rows,
 //! the `n x n` Gram matrix `G = (A - mu)(A - mu)^T` is accumulated in f64 over column blocks
@@ -12,7 +12,6 @@
 //! `sigma_j = sqrt(lambda_j)` and the principal directions `v_j = (A - mu)^T u_j / sigma_j`
 //! (the columns of V in eq. 5). Components are stored as f32.
 
-use crate::baseline::{BaselineMethod, Mapping};
 use crate::error::{EvalError, Result};
 use deepbrdf_data::Progress;
 use nalgebra::DMatrix;
@@ -277,18 +276,6 @@ fn centred_block(rows: &[&[f32]], mean: &[f32], b: usize) -> DMatrix<f64> {
         );
     }
     DMatrix::from_vec(cols, rows.len(), data)
-}
-
-/// The paper's "traditional PCA" (§4): natural log of the reflectance, all three channels of a
-/// BRDF in one row, mean-centred, truncated to k components.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Pca;
-
-impl Pca {
-    /// The method, as run by the harness.
-    pub fn method() -> BaselineMethod {
-        BaselineMethod::new("PCA", Mapping::log_kind())
-    }
 }
 
 #[cfg(test)]

@@ -156,8 +156,8 @@ mod tests {
         let set = TrainingSet { tables: &refs, names: &names, reference: &reference };
         let ks = [1, 2];
         for (ours, theirs) in [
-            (NestedBaseline::pca(), deepbrdf_eval::pca::Pca::method()),
-            (NestedBaseline::ipca(), deepbrdf_eval::ipca::Ipca::method()),
+            (NestedBaseline::pca(), deepbrdf_eval::baseline::BaselineMethod::pca()),
+            (NestedBaseline::ipca(), deepbrdf_eval::baseline::BaselineMethod::ipca()),
         ] {
             assert_eq!(ours.name(), theirs.name());
             let a = ours.fit_fold(&set, &ks, &Silent).unwrap();

@@ -12,7 +12,8 @@ use crate::deep_method::{DeepMethod, NAME};
 use crate::mapped_input::MappedInput;
 use deepbrdf_data::augment::{kept_slices, SliceSelection};
 use deepbrdf_data::{MerlTable, Progress};
-use deepbrdf_eval::figures::{write_atomic_file, write_chart, LineChart, Series};
+use deepbrdf_data::files::write_atomic;
+use deepbrdf_eval::figures::{write_chart, LineChart, Series};
 use deepbrdf_eval::harness::{Fold, Measure, Results, Yardstick};
 use deepbrdf_model::DeepBrdf;
 use std::fmt::Write as _;
@@ -229,7 +230,7 @@ impl Robustness {
                 r.mapped_mse
             );
         }
-        write_atomic_file(&dir.join("robustness.csv"), csv.as_bytes())?;
+        write_atomic(&dir.join("robustness.csv"), csv.as_bytes())?;
         let columns = Self::columns();
         let series = self
             .rows()

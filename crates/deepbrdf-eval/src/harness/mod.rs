@@ -226,7 +226,7 @@ mod tests {
     use std::sync::Mutex;
 
     fn methods() -> (BaselineMethod, BaselineMethod) {
-        (crate::pca::Pca::method(), crate::ipca::Ipca::method())
+        (crate::baseline::BaselineMethod::pca(), crate::baseline::BaselineMethod::ipca())
     }
 
     #[test]
