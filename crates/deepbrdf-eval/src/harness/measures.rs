@@ -150,8 +150,10 @@ impl Yardstick {
         let want_mapped = measures.contains(&Measure::MappedMse);
         let (a, b, r) = (original.table.values(), recon.values(), self.reference.values());
         let weights = grid::cos_weights();
-        // Sums of squared eq. (1) differences and of squared cosine-weighted differences.
-        let (mapped_sum, cos_sum) = original
+        // Sums of squared eq. (1) differences and of squared cosine-weighted differences: one
+        // partial sum per chunk in parallel, added in chunk order (the same bits for any thread
+        // count).
+        let parts: Vec<(f64, f64)> = original
             .cells
             .par_chunks(CHUNK)
             .enumerate()
@@ -174,7 +176,9 @@ impl Yardstick {
                 }
                 (mapped_sum, cos_sum)
             })
-            .reduce(|| (0.0, 0.0), |x, y| (x.0 + y.0, x.1 + y.1));
+            .collect();
+        let (mapped_sum, cos_sum) =
+            parts.iter().fold((0.0, 0.0), |x, y| (x.0 + y.0, x.1 + y.1));
         let count = (3 * n) as f64;
         Ok(measures
             .iter()
