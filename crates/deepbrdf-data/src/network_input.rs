@@ -37,7 +37,7 @@ mod tests {
                 let at = layout_index(h, d, p, rgb);
                 if table.is_valid(cell) {
                     let rho = f64::from(table.values()[rgb * CELLS + cell]);
-                    let want = log_relative(rho, 0.05) as f32;
+                    let want = log_relative(rho, f64::from(0.05f32)) as f32;
                     assert_eq!(input[at], want, "{h} {d} {p}");
                     assert_eq!(mask[at], 1.0);
                     checked += 1;
