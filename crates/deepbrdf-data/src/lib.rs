@@ -5,6 +5,7 @@ pub mod cache;
 pub mod dataset;
 pub mod error;
 pub mod fetch;
+pub mod ggx;
 pub mod gram_pca;
 pub mod files;
 pub mod layout;

@@ -9,7 +9,7 @@
 
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::baseline::{BaselineBasis, MappingKind};
-use deepbrdf_eval::harness::{Codec, Method, TrainingSet};
+use deepbrdf_eval::harness::{Codec, Method, FoldTraining};
 use deepbrdf_eval::{EvalError, Result};
 use std::sync::{Arc, Mutex};
 
@@ -57,7 +57,7 @@ impl Method for NestedBaseline {
 
     fn fit_fold(
         &self,
-        train: &TrainingSet<'_>,
+        train: &FoldTraining<'_>,
         ks: &[usize],
         progress: &dyn Progress,
     ) -> Result<Vec<Box<dyn Codec>>> {
@@ -153,7 +153,7 @@ mod tests {
         let refs: Vec<&MerlTable> = tables.iter().collect();
         let names: Vec<String> = (0..3).map(|i| format!("m{i}")).collect();
         let reference = MedianReference::from_tables(&refs).unwrap();
-        let set = TrainingSet { tables: &refs, names: &names, reference: &reference };
+        let set = FoldTraining { tables: &refs, names: &names, reference: &reference };
         let ks = [1, 2];
         for (ours, theirs) in [
             (NestedBaseline::pca(), deepbrdf_eval::baseline::BaselineMethod::pca()),

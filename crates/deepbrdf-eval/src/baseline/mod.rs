@@ -9,7 +9,7 @@ pub use domain::Domain;
 pub use mapping::{Mapping, MappingKind};
 
 use crate::error::{EvalError, Result};
-use crate::harness::{Codec, Method, TrainingSet};
+use crate::harness::{Codec, Method, FoldTraining};
 use crate::pca::LinearBasis;
 use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::{MerlTable, Progress};
@@ -275,7 +275,7 @@ impl Method for BaselineMethod {
     /// As [`Method::fit_ks`], reusing the fold's median reference for IPCA.
     fn fit_fold(
         &self,
-        train: &TrainingSet<'_>,
+        train: &FoldTraining<'_>,
         ks: &[usize],
         progress: &dyn Progress,
     ) -> Result<Vec<Box<dyn Codec>>> {
