@@ -2,7 +2,11 @@
 //! two-channel network trained for one epoch, k = 1 and 2. The second run must reuse the
 //! trained models (and so reproduce the first run's numbers exactly).
 use crate::util;
+use deepbrdf_data::augment::{kept_slices, SliceSelection};
 use deepbrdf_data::merl::write_merl;
+use deepbrdf_data::MerlTable;
+use deepbrdf_eval::harness::{Measure, Yardstick};
+use std::collections::BTreeMap;
 use deepbrdf_model::burn::config::Config as _;
 use deepbrdf_model::{AutoencoderConfig, TrainConfig};
 use std::path::Path;
@@ -209,4 +213,46 @@ fn sweep_k_with_the_cpu_preset_network_beats_pca_and_is_thread_count_independent
     assert!(deep2 < 0.1 * deep1, "DeepBRDF k = 1: {deep1}, k = 2: {deep2}");
     assert!(deep2 < pca1, "DeepBRDF k = 2: {deep2}, PCA k = 1: {pca1}");
     assert!(rows.iter().all(|r| r.4.is_finite() && r.4 >= 0.0));
+
+    // robustness.csv: DeepBRDF from all slices repeats results.csv; the nearest-slice fill is
+    // the harness's mapped MSE of the filled table, computed here directly, and grows as fewer
+    // slices are kept.
+    let robustness = String::from_utf8(outputs[0].1.clone()).unwrap();
+    let mut lines = robustness.lines();
+    assert_eq!(lines.next(), Some("input,method,k,fold,material,mapped_mse"));
+    let records: Vec<Vec<String>> =
+        lines.map(|l| l.split(',').map(str::to_string).collect()).collect();
+    let tables: Vec<MerlTable> = (0..3).map(util::material).collect();
+    let refs: Vec<&MerlTable> = tables.iter().collect();
+    let yardstick = Yardstick::from_training(&refs).unwrap();
+    let mut fills = BTreeMap::new();
+    for r in &records {
+        let value: f64 = r[5].parse().unwrap();
+        let i: usize = r[4].trim_start_matches('m').parse().unwrap();
+        match (r[0].as_str(), r[1].as_str()) {
+            ("1/1", "DeepBRDF") => {
+                let k: usize = r[2].parse().unwrap();
+                let full = rows
+                    .iter()
+                    .find(|x| x.0 == "DeepBRDF" && x.1 == k && x.2 == r[4] && x.3 == "mapped_mse")
+                    .unwrap();
+                assert_eq!(value, full.4, "{r:?}");
+            }
+            (every, "nearest-slice fill") => {
+                let n: usize = every.trim_start_matches("1/").parse().unwrap();
+                let kept = kept_slices(&SliceSelection::Every(n), 0);
+                let filled = tables[i].with_kept_slices(&kept);
+                let want = yardstick
+                    .measure(&yardstick.original(&tables[i]), &filled, &[Measure::MappedMse])
+                    .unwrap()[0];
+                assert_eq!(value, want, "{r:?}");
+                fills.insert((i, n), value);
+            }
+            _ => {}
+        }
+    }
+    assert_eq!(fills.len(), 3 * 2, "{robustness}");
+    for i in 0..3 {
+        assert!(0.0 < fills[&(i, 3)] && fills[&(i, 3)] < fills[&(i, 9)], "{fills:?}");
+    }
 }
