@@ -103,7 +103,10 @@ fn baselines_in_sample_writes_results_and_bases_and_protects_them() {
     for method in ["PCA", "IPCA"] {
         for measure in ["mapped_mse", "cos_rmse"] {
             let mean = |k: usize| {
-                names.iter().map(|n| rows[&(method.into(), k, n.clone(), measure.into())]).sum::<f64>()
+                names
+                    .iter()
+                    .map(|n| rows[&(method.into(), k, n.clone(), measure.into())])
+                    .sum::<f64>()
                     / 4.0
             };
             assert!(mean(3) < 1e-3 * mean(1), "{method} {measure}: {} -> {}", mean(1), mean(3));

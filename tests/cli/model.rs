@@ -66,13 +66,15 @@ fn train_encode_decode_and_reconstruct_a_spectral_model() {
     let own_id = value["model_id"].as_str().unwrap().to_string();
     let foreign = dir.path().join("foreign.json");
     std::fs::write(&foreign, text.replace(&own_id, "0123456789abcdef")).unwrap();
-    let out =
-        util::run_in(dir.path(), &["decode", &s(&run), &s(&foreign), "-o", "foreign.binary"]);
+    let out = util::run_in(dir.path(), &["decode", &s(&run), &s(&foreign), "-o", "foreign.binary"]);
     util::assert_clean_failure(&out, "made by model 0123456789abcdef");
     util::assert_clean_failure(&out, &own_id);
     assert!(!dir.path().join("foreign.binary").exists(), "nothing written on refusal");
     ok(&["decode", &s(&run), &s(&foreign), "-o", "foreign.binary", "--force"]);
-    assert_eq!(read_merl(dir.path().join("foreign.binary")).unwrap(), read_merl(&decoded_path).unwrap());
+    assert_eq!(
+        read_merl(dir.path().join("foreign.binary")).unwrap(),
+        read_merl(&decoded_path).unwrap()
+    );
     let mut long = value.clone();
     long["latent"] = serde_json::json!([0.1, 0.2, 0.3]);
     long["k"] = serde_json::json!(3);

@@ -6,9 +6,9 @@ use deepbrdf_data::augment::{kept_slices, SliceSelection};
 use deepbrdf_data::merl::write_merl;
 use deepbrdf_data::MerlTable;
 use deepbrdf_eval::harness::{Measure, Yardstick};
-use std::collections::BTreeMap;
 use deepbrdf_model::burn::config::Config as _;
 use deepbrdf_model::{AutoencoderConfig, TrainConfig};
+use std::collections::BTreeMap;
 use std::path::Path;
 
 fn tiny_config(path: &Path) {

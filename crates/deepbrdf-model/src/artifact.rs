@@ -26,11 +26,11 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 use crate::atomic::{read_limited, write_atomic};
-use deepbrdf_data::files::sync_dir_of;
 use crate::autoencoder::{Autoencoder, AutoencoderConfig};
 use crate::compact::CompactBasis;
 use crate::error::{ModelError, Result};
 use crate::train::Trained;
+use deepbrdf_data::files::sync_dir_of;
 
 /// File name of the manifest.
 pub const MANIFEST_FILE: &str = "model.json";

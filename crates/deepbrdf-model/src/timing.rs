@@ -16,10 +16,10 @@ use rand_chacha::ChaCha8Rng;
 use crate::artifact::{ModelArtifact, Provenance};
 use crate::autoencoder::{AutoencoderConfig, INPUT_VALUES};
 use crate::codec::DeepBrdf;
-use deepbrdf_data::merl::grid::valid_mask;
 use crate::error::{ModelError, Result};
 use crate::train::{coefficient_gradients, gradients};
 use crate::training_set::TrainingSet;
+use deepbrdf_data::merl::grid::valid_mask;
 
 /// Median and all timings of repeated runs, in seconds.
 #[derive(Debug, Clone)]

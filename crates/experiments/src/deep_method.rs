@@ -8,7 +8,7 @@
 use crate::mapped_input::InputCache;
 use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::{MerlTable, Progress};
-use deepbrdf_eval::harness::{Codec, Method, FoldTraining};
+use deepbrdf_eval::harness::{Codec, FoldTraining, Method};
 use deepbrdf_eval::{EvalError, Result};
 use deepbrdf_model::artifact::MODEL_DIR;
 use deepbrdf_model::burn::tensor::Device;

@@ -9,7 +9,7 @@
 
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::baseline::{BaselineBasis, MappingKind};
-use deepbrdf_eval::harness::{Codec, Method, FoldTraining};
+use deepbrdf_eval::harness::{Codec, FoldTraining, Method};
 use deepbrdf_eval::{EvalError, Result};
 use std::sync::{Arc, Mutex};
 

@@ -11,8 +11,8 @@
 use crate::deep_method::{DeepMethod, NAME};
 use crate::mapped_input::MappedInput;
 use deepbrdf_data::augment::{kept_slices, SliceSelection};
-use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_data::files::write_atomic;
+use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::figures::{write_chart, LineChart, Series};
 use deepbrdf_eval::harness::{Fold, Measure, Results, Yardstick};
 use deepbrdf_model::DeepBrdf;
@@ -273,7 +273,13 @@ fn csv_field(s: &str) -> String {
 mod tests {
     use super::*;
 
-    fn record(every: usize, method: &str, k: Option<usize>, material: &str, v: f64) -> RobustnessRecord {
+    fn record(
+        every: usize,
+        method: &str,
+        k: Option<usize>,
+        material: &str,
+        v: f64,
+    ) -> RobustnessRecord {
         RobustnessRecord {
             every,
             method: method.into(),

@@ -1,9 +1,7 @@
 //! The scene and rendering arguments shared by `render`, `compare` and `sheet`:
 //! `--shape`, `--light`, `--view`, `--fov`, `--size`, `--spp`, `--seed`, `--exposure`.
 use anyhow::Context;
-use deepbrdf_render::{
-    LightSpec, Projection, RenderSettings, Scene, SceneConfig, Shape, Tonemap,
-};
+use deepbrdf_render::{LightSpec, Projection, RenderSettings, Scene, SceneConfig, Shape, Tonemap};
 
 #[derive(Debug, Clone, clap::Args)]
 pub struct SceneArgs {

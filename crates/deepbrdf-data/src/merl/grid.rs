@@ -32,7 +32,6 @@ pub fn cell_coords(cell: usize) -> (usize, usize, usize) {
     (cell / (N_THETA_D * N_PHI_D), (cell / N_PHI_D) % N_THETA_D, cell % N_PHI_D)
 }
 
-
 /// theta_h (radians) of index `i`: the inverse of MERL's square-root warp.
 #[inline]
 pub fn theta_h_of(i: usize) -> f64 {

@@ -137,11 +137,13 @@ impl Mapping {
                 let y = f64::from(row[c * n + m]);
                 let rho = match self {
                     Self::Log => pca::log_unmap(y),
-                    Self::LogRelative { reference, cos_weight } => ipca::cosine_log_relative_inverse(
-                        y,
-                        f64::from(reference[c * n + m]),
-                        f64::from(cos_weight[m]),
-                    ),
+                    Self::LogRelative { reference, cos_weight } => {
+                        ipca::cosine_log_relative_inverse(
+                            y,
+                            f64::from(reference[c * n + m]),
+                            f64::from(cos_weight[m]),
+                        )
+                    }
                 };
                 out[cell as usize - first] = clamp_reflectance(rho);
             }

@@ -9,7 +9,7 @@ pub use domain::Domain;
 pub use mapping::{Mapping, MappingKind};
 
 use crate::error::{EvalError, Result};
-use crate::harness::{Codec, Method, FoldTraining};
+use crate::harness::{Codec, FoldTraining, Method};
 use crate::pca::LinearBasis;
 use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::{MerlTable, Progress};

@@ -177,8 +177,7 @@ impl Yardstick {
                 (mapped_sum, cos_sum)
             })
             .collect();
-        let (mapped_sum, cos_sum) =
-            parts.iter().fold((0.0, 0.0), |x, y| (x.0 + y.0, x.1 + y.1));
+        let (mapped_sum, cos_sum) = parts.iter().fold((0.0, 0.0), |x, y| (x.0 + y.0, x.1 + y.1));
         let count = (3 * n) as f64;
         Ok(measures
             .iter()

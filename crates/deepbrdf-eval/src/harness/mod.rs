@@ -7,7 +7,7 @@ mod measures;
 mod modes;
 mod report;
 
-pub use codec::{Codec, Method, FoldTraining};
+pub use codec::{Codec, FoldTraining, Method};
 pub use deepbrdf_data::mapping::MedianReference;
 pub use measures::{Measure, Original, Yardstick};
 pub use modes::{Fold, Mode};
