@@ -153,13 +153,9 @@ fn baselines_write_the_same_bytes_with_one_thread_and_with_several() {
     write_materials(&data, 5);
     let data = data.to_str().unwrap();
     let mut csv = Vec::new();
-    for (threads, out) in [("1", "one"), ("3", "three")] {
-        let output = std::process::Command::new(env!("CARGO_BIN_EXE_experiments"))
-            .args(["baselines", "--data", data, "--k", "1,2", "--out", out, "--quiet"])
-            .env("RAYON_NUM_THREADS", threads)
-            .current_dir(dir.path())
-            .output()
-            .unwrap();
+    for (threads, out) in [(1, "one"), (3, "three")] {
+        let args = ["baselines", "--data", data, "--k", "1,2", "--out", out];
+        let output = util::run_on_threads(dir.path(), &args, threads);
         assert!(output.status.success(), "{}", util::stderr(&output));
         csv.push(std::fs::read(dir.path().join(out).join("results.csv")).unwrap());
     }

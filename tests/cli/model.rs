@@ -3,7 +3,7 @@
 //! model directory holds the compact basis, the commands chain, a reconstruction of a training
 //! material comes back close, and bad inputs are named.
 use crate::util;
-use deepbrdf_data::merl::{read_merl, write_merl};
+use deepbrdf_data::merl::read_merl;
 use deepbrdf_model::burn::config::Config as _;
 use deepbrdf_model::{AutoencoderConfig, TrainConfig};
 use std::path::Path;
@@ -15,11 +15,7 @@ fn s(p: &Path) -> String {
 #[test]
 fn train_encode_decode_and_reconstruct_a_spectral_model() {
     let dir = tempfile::tempdir().unwrap();
-    let data = dir.path().join("data");
-    std::fs::create_dir(&data).unwrap();
-    for i in 0..3 {
-        write_merl(&util::material(i), data.join(format!("m{i}.binary"))).unwrap();
-    }
+    let data = util::write_data(dir.path(), 3);
     let mut config = TrainConfig::cpu(2).with_epochs(3).with_batch_size(2);
     config.model = AutoencoderConfig::spectral(2, 3, Some(8));
     let config_path = dir.path().join("tiny.json");
@@ -100,9 +96,7 @@ fn train_encode_decode_and_reconstruct_a_spectral_model() {
 #[test]
 fn train_names_a_bad_config_file_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let data = dir.path().join("data");
-    std::fs::create_dir(&data).unwrap();
-    write_merl(&util::material(0), data.join("m0.binary")).unwrap();
+    let data = util::write_data(dir.path(), 1);
     let saved = dir.path().join("saved.json");
     TrainConfig::cpu(2).save(&saved).unwrap();
     let mut good: serde_json::Value =

@@ -3,7 +3,6 @@
 //! trained models (and so reproduce the first run's numbers exactly).
 use crate::util;
 use deepbrdf_data::augment::{kept_slices, SliceSelection};
-use deepbrdf_data::merl::write_merl;
 use deepbrdf_data::MerlTable;
 use deepbrdf_eval::harness::{Measure, Yardstick};
 use deepbrdf_model::burn::config::Config as _;
@@ -27,11 +26,7 @@ fn tiny_config(path: &Path) {
 #[test]
 fn sweep_k_writes_results_and_reuses_trained_models() {
     let dir = tempfile::tempdir().unwrap();
-    let data = dir.path().join("data");
-    std::fs::create_dir(&data).unwrap();
-    for i in 0..3 {
-        write_merl(&util::material(i), data.join(format!("m{i}.binary"))).unwrap();
-    }
+    let data = util::write_data(dir.path(), 3);
     let config = dir.path().join("tiny.json");
     tiny_config(&config);
     let readme = dir.path().join("README.md");
@@ -150,16 +145,12 @@ fn rows(csv: &str) -> Vec<(String, usize, String, String, f64)> {
 #[test]
 fn sweep_k_with_the_cpu_preset_network_beats_pca_and_is_thread_count_independent() {
     let dir = tempfile::tempdir().unwrap();
-    let data = dir.path().join("data");
-    std::fs::create_dir(&data).unwrap();
-    for i in 0..3 {
-        write_merl(&util::material(i), data.join(format!("m{i}.binary"))).unwrap();
-    }
+    let data = util::write_data(dir.path(), 3);
     let config = dir.path().join("spectral.json");
     spectral_config(&config);
     let s = |p: &Path| p.to_str().unwrap().to_string();
     let mut outputs = Vec::new();
-    for (threads, out) in [("1", "one"), ("3", "three")] {
+    for (threads, out) in [(1, "one"), (3, "three")] {
         let out = dir.path().join(out);
         let args = [
             "sweep-k".to_string(),
@@ -177,14 +168,9 @@ fn sweep_k_with_the_cpu_preset_network_beats_pca_and_is_thread_count_independent
             "2".into(),
             "--fig2-material".into(),
             "m1".into(),
-            "--quiet".into(),
         ];
-        let run = std::process::Command::new(env!("CARGO_BIN_EXE_experiments"))
-            .args(&args)
-            .env("RAYON_NUM_THREADS", threads)
-            .current_dir(dir.path())
-            .output()
-            .unwrap();
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let run = util::run_on_threads(dir.path(), &args, threads);
         assert!(run.status.success(), "{}", util::stderr(&run));
         assert!(out.join("models/fold0/k2/model/basis.f16").is_file(), "a spectral model");
         outputs.push((
