@@ -25,11 +25,12 @@ use deepbrdf_data::mapping::MedianReference;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
-use crate::atomic::{read_limited, sync_parent, write_atomic};
+use crate::atomic::{read_limited, write_atomic};
 use crate::autoencoder::{Autoencoder, AutoencoderConfig};
 use crate::compact::CompactBasis;
 use crate::error::{ModelError, Result};
 use crate::train::Trained;
+use deepbrdf_data::files::sync_dir_of;
 
 /// File name of the manifest.
 pub const MANIFEST_FILE: &str = "model.json";
@@ -475,7 +476,7 @@ fn replace_dir(tmp: &Path, dir: &Path) -> Result<()> {
     } else {
         fs::rename(tmp, dir).map_err(|e| ModelError::io(dir, e))?;
     }
-    sync_parent(dir);
+    sync_dir_of(dir);
     Ok(())
 }
 

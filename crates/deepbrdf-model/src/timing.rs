@@ -15,10 +15,11 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::artifact::{ModelArtifact, Provenance};
 use crate::autoencoder::{AutoencoderConfig, INPUT_VALUES};
-use crate::codec::{grid_mask, DeepBrdf};
+use crate::codec::DeepBrdf;
 use crate::error::{ModelError, Result};
 use crate::train::{coefficient_gradients, gradients};
 use crate::training_set::TrainingSet;
+use deepbrdf_data::merl::grid::valid_mask;
 
 /// Median and all timings of repeated runs, in seconds.
 #[derive(Debug, Clone)]
@@ -94,7 +95,7 @@ pub fn training_steps(
 
 /// `n` BRDFs of seeded random mapped values on the MERL grid's mask.
 fn synthetic_set(n: usize) -> Result<TrainingSet> {
-    let mask = mask_layout(&grid_mask());
+    let mask = mask_layout(valid_mask());
     let mut rng = ChaCha8Rng::seed_from_u64(0);
     let inputs =
         (0..n).map(|_| mask.iter().map(|&m| m * rng.random_range(0.0..2.0f32)).collect()).collect();
@@ -122,7 +123,7 @@ pub struct DecodeTiming {
 pub fn decode(config: &AutoencoderConfig, repeats: usize, device: &Device) -> Result<DecodeTiming> {
     let device = device.clone().without_autodiff();
     let mut model = config.init_seeded(0, &device)?;
-    let valid = mask_layout(&grid_mask());
+    let valid = mask_layout(valid_mask());
     let mut rng = ChaCha8Rng::seed_from_u64(1);
     if config.mean_offset {
         let offset: Vec<f32> = valid.iter().map(|&m| m * rng.random_range(-1.0..1.0f32)).collect();

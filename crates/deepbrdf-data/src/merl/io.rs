@@ -8,7 +8,8 @@
 //! [`read_merl`] / [`write_merl`] convert to and from the f32 [`MerlTable`] in physical units.
 //! Sizes are checked before anything is allocated and writes are atomic.
 
-use super::table::{MerlTable, CELLS, INVALID_VALUE, MERL_SCALE, N_PHI_D, N_THETA_D, N_THETA_H};
+use super::grid::{CELLS, N_PHI_D, N_THETA_D, N_THETA_H};
+use super::table::{MerlTable, INVALID_VALUE, MERL_SCALE};
 use crate::error::{DataError, Result};
 use crate::files::{open_regular, read_exactly, write_atomic};
 use std::io::Read;
@@ -165,7 +166,7 @@ fn stored(c: usize, physical: f32) -> f64 {
 
 /// "channel, cell (theta_h, theta_d, phi_d)" of a flat value index, for messages.
 fn describe(i: usize) -> String {
-    let (h, d, p) = super::table::cell_coords(i % CELLS);
+    let (h, d, p) = super::grid::cell_coords(i % CELLS);
     let channel = ["red", "green", "blue"][i / CELLS];
     format!("{channel} value at theta_h {h}, theta_d {d}, phi_d {p}")
 }

@@ -14,8 +14,8 @@ use crate::robustness::{self, Robustness, NEAREST_FILL};
 use crate::slices_figure::{self, FIG2_MATERIAL};
 use anyhow::{bail, Context};
 use deepbrdf_data::dataset::Dataset;
+use deepbrdf_data::files::write_atomic;
 use deepbrdf_data::Progress;
-use deepbrdf_eval::figures::write_atomic_file;
 use deepbrdf_eval::harness::{self, HarnessConfig, Materials, Measure, Mode, Results};
 use deepbrdf_model::burn::config::Config as _;
 use deepbrdf_model::{Preset, TrainConfig};
@@ -230,7 +230,7 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
         loaded_at,
         wall,
     };
-    write_atomic_file(&out.join("summary.md"), report.summary_markdown().as_bytes())?;
+    write_atomic(&out.join("summary.md"), report.summary_markdown().as_bytes())?;
     if let Some(readme) = &args.update_readme {
         let block = report.readme_block(readme, &out)?;
         readme_block::update_file(readme, README_BEGIN, README_END, &block)?;
@@ -278,7 +278,7 @@ fn write_training_csv(fits: &[FitRecord], out: &Path) -> anyhow::Result<()> {
             f.dir.display()
         );
     }
-    write_atomic_file(&out.join("training.csv"), csv.as_bytes())?;
+    write_atomic(&out.join("training.csv"), csv.as_bytes())?;
     Ok(())
 }
 
