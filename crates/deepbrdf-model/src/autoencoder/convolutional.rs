@@ -1,9 +1,9 @@
 //! Table 1's convolutional autoencoder (Hu et al., CGF 2020, §3.2): three 3x3 stride-2
 //! convolutions (540 -> 256 -> 128 -> 64 channels, 90 -> 45 -> 23 -> 12 pixels), residual
 //! blocks at 64 x 12 x 12, FC to k, FC back and three deconvolutions to 128 x 24 x 24,
-//! 256 x 48 x 48 and 540 x 90 x 90 (the last 4x4), with the paddings of the PyTorch reference
-//! (the repository's `shared/bench/torch_table1.py`); optionally narrower, behind a per-pixel
-//! projection of the 540 channels, and around a fixed offset.
+//! 256 x 48 x 48 and 540 x 90 x 90 (the last 4x4), with PyTorch's padding conventions (spelled
+//! out at each layer); optionally narrower, behind a per-pixel projection of the 540 channels,
+//! and around a fixed offset.
 
 use burn::module::Param;
 use burn::nn::conv::{Conv2d, Conv2dConfig, ConvTranspose2d, ConvTranspose2dConfig};
