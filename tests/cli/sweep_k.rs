@@ -5,19 +5,20 @@ use crate::util;
 use deepbrdf_data::augment::{kept_slices, SliceSelection};
 use deepbrdf_data::MerlTable;
 use deepbrdf_eval::harness::{Measure, Yardstick};
+use deepbrdf_model::autoencoder::ConvolutionalConfig;
 use deepbrdf_model::burn::config::Config as _;
 use deepbrdf_model::{AutoencoderConfig, TrainConfig};
 use std::collections::BTreeMap;
 use std::path::Path;
 
 fn tiny_config(path: &Path) {
-    let model = AutoencoderConfig::new()
-        .with_latent(2)
+    let layers = ConvolutionalConfig::new()
         .with_projection(Some(2))
         .with_encoder_channels([2, 2, 2])
         .with_residual_blocks(0)
         .with_decoder_channels([2, 2])
         .with_mean_offset(true);
+    let model = AutoencoderConfig::convolutional(2, layers);
     let mut config = TrainConfig::cpu(2).with_epochs(1).with_batch_size(4);
     config.model = model;
     config.save(path).expect("writing the training configuration");

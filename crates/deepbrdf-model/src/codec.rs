@@ -47,7 +47,9 @@ impl DeepBrdf {
         let basis = match compact {
             Some(basis) => Some(basis),
             // A version 1 model: the f32 basis is in the network.
-            None if artifact.config().spectral_only() => Some(model.take_compact_basis()?),
+            None if artifact.config().spectral_config().is_some() => {
+                Some(CompactBasis::take_from(&mut model)?)
+            }
             None => None,
         };
         Ok(Self { model, basis, artifact, grid_mask: valid_mask(), device })
@@ -181,13 +183,13 @@ mod tests {
 
     fn codec() -> DeepBrdf {
         let device = DeviceKind::default_kind().unwrap().device().unwrap();
-        let config = AutoencoderConfig::new()
-            .with_latent(3)
+        let layers = crate::autoencoder::ConvolutionalConfig::new()
             .with_projection(Some(1))
             .with_encoder_channels([1, 1, 1])
             .with_residual_blocks(0)
             .with_decoder_channels([1, 1])
             .with_mean_offset(true);
+        let config = AutoencoderConfig::convolutional(3, layers);
         let offset: Vec<f32> = (0..INPUT_VALUES).map(|i| 0.5 + 0.1 * ((i % 11) as f32)).collect();
         let model = config.init_seeded(3, &device).unwrap().with_offset(&offset).unwrap();
         let provenance = Provenance::untrained("synthetic", 3);
