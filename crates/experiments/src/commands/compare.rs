@@ -38,11 +38,12 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let (name_b, b) =
         load_material(&args.b, &cache).with_context(|| format!("loading material '{}'", args.b))?;
     let scene = scene_config.build()?;
-    // Both rendered with A's sampling proxy and the same seed: the same directions are drawn, so
-    // the difference is the materials', not Monte Carlo noise.
+    // Both rendered with A's sampling and the same seed: the same directions are drawn, so the
+    // difference is the materials', not Monte Carlo noise.
     let brdf_a = MerlBrdf::new(&a);
     let image_a = render(&scene, &brdf_a, &settings, progress)?;
-    let image_b = render(&scene, &MerlBrdf::new(&b).with_lobe(brdf_a.lobe()), &settings, progress)?;
+    let brdf_b = MerlBrdf::new_sampled(&b, brdf_a.sampling().clone());
+    let image_b = render(&scene, &brdf_b, &settings, progress)?;
     let c = compare_images(&image_b, &image_a, &tonemap)?;
     difference_image(&image_b, &image_a, args.scale)?.write_png(&args.output)?;
     println!(
