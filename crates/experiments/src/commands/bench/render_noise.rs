@@ -117,3 +117,30 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn relative_noise_of_known_images() {
+        // Four covered pixels at level 2 (a) and 2 +- 0.2 alternating (b), plus uncovered and
+        // partly covered pixels that must be ignored: the difference has sd 0.2 * sqrt(4/3)
+        // (sample sd of +-0.2), so the noise is that / sqrt(2) / mean level (2, 2.1, 1.9 mean 2).
+        let a = Image::from_pixels(3, 2, vec![[2.0; 3]; 6], vec![1.0, 1.0, 1.0, 1.0, 0.5, 0.0])
+            .unwrap();
+        let b = Image::from_pixels(
+            3,
+            2,
+            vec![[2.2; 3], [1.8; 3], [2.2; 3], [1.8; 3], [9.0; 3], [9.0; 3]],
+            vec![1.0; 6],
+        )
+        .unwrap();
+        let want = 0.2 * (4.0f64 / 3.0).sqrt() / 2f64.sqrt() / 2.0;
+        let got = relative_noise(&a, &b).unwrap();
+        assert!((got - want).abs() < 1e-6, "{got} vs {want}");
+        assert_eq!(relative_noise(&a, &a), Some(0.0));
+        let black = Image::from_pixels(3, 2, vec![[0.0; 3]; 6], vec![1.0; 6]).unwrap();
+        assert_eq!(relative_noise(&black, &black), None);
+    }
+}
