@@ -6,10 +6,11 @@
 //! light, and the environment by multiple importance sampling with both strategies at every
 //! shading point (Veach 1997, §9.2, the multi-sample model with the power heuristic, beta = 2):
 //! one direction per light strategy of the environment
-//! ([`crate::light::Environment::sample_at`]: the constant environment cosine-weighted over the
-//! shading point's upper hemisphere; the sun's cone and the sky's map) and one from the BRDF's.
-//! Light sampling finds the sun, BRDF sampling finds mirror reflections, and the heuristic keeps
-//! each where it is better.
+//! ([`crate::light::Environment::sample_at`]: the sun's cone and the sky's map) and one from the
+//! BRDF's. Light sampling finds the sun, BRDF sampling finds mirror reflections, and the
+//! heuristic keeps each where it is better. The constant environment has no light strategy of
+//! its own (see [`crate::light::Environment::strategies`]): BRDF sampling alone follows its
+//! integrand.
 
 use super::brdf::{Brdf, Rgb};
 use super::geometry::{Frame, Vec3};
@@ -166,7 +167,10 @@ fn shade(
         *x = rng.random();
     }
     let u_brdf = [rng.random::<f64>(), rng.random::<f64>()];
-    let sum_sq = |p: &[f64; MAX_STRATEGIES], b: f64| p.iter().map(|x| x * x).sum::<f64>() + b * b;
+    // Only the strategies that draw samples enter the heuristic.
+    let sum_sq = |p: &[f64; MAX_STRATEGIES], b: f64| {
+        p[..strategies].iter().map(|x| x * x).sum::<f64>() + b * b
+    };
     for i in 0..strategies {
         let (dir, radiance, pdfs) = env.sample_at(i, frame, [u[2 * i], u[2 * i + 1]]);
         let wi = frame.to_local(dir);
@@ -288,9 +292,8 @@ mod tests {
 
     #[test]
     fn white_furnace_is_exact_for_a_lambertian() {
-        // Albedo 1 under constant radiance L reflects L everywhere. Light samples (cosine over
-        // the hemisphere) and BRDF samples (cosine) both give exactly L, and the power
-        // heuristic's weights sum to one: every pixel is L up to rounding.
+        // Albedo 1 under constant radiance L reflects L everywhere. BRDF samples (cosine) give
+        // exactly L: every pixel is L up to rounding.
         let values = furnace(&Lambertian::new([1.0; 3]), 4, 11);
         assert!(values.len() > 300, "{} covered pixels", values.len());
         for v in values {
