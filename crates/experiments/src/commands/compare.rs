@@ -35,11 +35,11 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         load_material(&args.a, &cache).with_context(|| format!("loading material '{}'", args.a))?;
     let (name_b, b) =
         load_material(&args.b, &cache).with_context(|| format!("loading material '{}'", args.b))?;
-    // Both rendered with A's sampling proxy and the same seed: the same directions are drawn, so
-    // the difference is the materials', not Monte Carlo noise.
+    // Both rendered with A's sampling and the same seed: the same directions are drawn, so the
+    // difference is the materials', not Monte Carlo noise.
     let brdf_a = MerlBrdf::new(&a);
     let image_a = render(&setup.scene, &brdf_a, &setup.settings, progress)?;
-    let brdf_b = MerlBrdf::new(&b).with_lobe(brdf_a.lobe());
+    let brdf_b = MerlBrdf::new_sampled(&b, brdf_a.sampling().clone());
     let image_b = render(&setup.scene, &brdf_b, &setup.settings, progress)?;
     let c = compare_images(&image_b, &image_a, &setup.tonemap)?;
     difference_image(&image_b, &image_a, args.scale)?.write_png(&args.output)?;
