@@ -17,6 +17,8 @@ pub const N_PHI_D: usize = 180;
 pub const CELLS: usize = N_THETA_H * N_THETA_D * N_PHI_D;
 /// Values per table, all three channels: 4,374,000.
 pub const VALUES: usize = 3 * CELLS;
+/// Cells in one theta_h row of the grid (all theta_d and phi_d): 16,200.
+pub const ROW: usize = N_THETA_D * N_PHI_D;
 
 /// Colour scales of MERL's reference reader (`BRDFRead.cpp`, Matusik et al. 2003): the stored value
 /// of channel c times `MERL_SCALE[c]` is reflectance in 1/sr. Red 1/1500, green 1.15/1500,
@@ -71,6 +73,23 @@ impl MerlTable {
             return Err(DataError::Invalid(format!("value {i} is {} (not finite)", values[i])));
         }
         Ok(Self { values })
+    }
+
+    /// A table filled one theta_h row at a time, rows in parallel (rayon): `fill(i, [r, g, b])`
+    /// writes row `i` of the three channels ([`ROW`] cells each, preset to [`INVALID_VALUE`]).
+    /// Rows are independent, so the table does not depend on the thread count. Fails if a value
+    /// is non-finite (see [`MerlTable::from_values`]).
+    pub fn from_par_rows(fill: impl Fn(usize, [&mut [f32]; 3]) + Sync) -> Result<Self> {
+        use rayon::prelude::*;
+        let mut values = vec![INVALID_VALUE; VALUES];
+        let (r, rest) = values.split_at_mut(CELLS);
+        let (g, b) = rest.split_at_mut(CELLS);
+        r.par_chunks_mut(ROW)
+            .zip(g.par_chunks_mut(ROW))
+            .zip(b.par_chunks_mut(ROW))
+            .enumerate()
+            .for_each(|(i, ((r, g), b))| fill(i, [r, g, b]));
+        Self::from_values(values)
     }
 
     /// Builds a table by evaluating `f(theta_h, theta_d, phi_d) -> rgb` (indices) at valid cells;
