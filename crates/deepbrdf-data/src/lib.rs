@@ -11,6 +11,7 @@ pub mod mapping;
 pub mod merl;
 pub mod nbrdf;
 pub mod progress;
+pub mod rgl;
 pub mod summary;
 pub mod testing;
 
