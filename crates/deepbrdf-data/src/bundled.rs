@@ -143,6 +143,12 @@ pub fn find_material(spec: &str) -> Result<(Collection, &'static Network)> {
         Some((col, name)) => (vec![col.parse::<Collection>()?], name),
         None => (Collection::ALL.to_vec(), spec),
     };
+    if collections.iter().any(|c| c.is_measured()) {
+        return Err(DataError::Invalid(format!(
+            "{spec:?} names a measurement, not a network (load it as a material, e.g. with \
+             `experiments info {spec}`, or write a MERL file with `experiments convert`)"
+        )));
+    }
     for &col in &collections {
         if let Some(net) = col.get(name)? {
             return Ok((col, net));
@@ -226,6 +232,8 @@ mod tests {
         let err = find_material("merl/cardboard_rgb").expect_err("wrong collection").to_string();
         assert!(err.contains("no bundled material"), "{err}");
         assert!(find_material("nope/chrome").is_err());
+        let err = find_material("rgl-measured/paper_white_rgb").expect_err("no network");
+        assert!(err.to_string().contains("measurement, not a network"), "{err}");
     }
 
     /// The 20 reference evaluations computed by the data's authors in float64 from the original
