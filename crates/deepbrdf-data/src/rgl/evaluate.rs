@@ -7,9 +7,9 @@
 //!    `u = sqrt(theta / (pi/2))` and phi to `(phi + pi) / 2 pi` (wm's azimuth relative to wi's);
 //! 2. `u_wm` is mapped back through the VNDF warp (the `vndf` table, interpolated over theta_i)
 //!    to the unit square where the `rgb` table is sampled: `sample = vndf.invert(u_wm)`;
-//! 3. `f_r cos(theta_o) = rgb(sample; theta_i) * ndf(u_wm) / (4 sigma(u_wi))` (eq. 14 of the
-//!    paper with the VNDF `D(wm) G1(wi) <wi, wm> / cos(theta_i)` and `sigma(wi) = cos(theta_i) /
-//!    G1(wi)`, the projected area).
+//! 3. `f_r cos(theta_o) = rgb(sample; theta_i) * ndf(u_wm) / (4 sigma(u_wi))`: the measured
+//!    table, stored relative to the microfacet sampling density, times the NDF over four times
+//!    the projected area `sigma` (the paper's factorisation; the reference's `BRDF::eval`).
 //!
 //! The reference returns `f_r cos(theta_o)` ([`RglBrdf::eval_cos`]). A MERL cell stands for both
 //! orderings of its two directions (phi_d and phi_d + pi are folded together), and measured data

@@ -1,4 +1,4 @@
-//! The 2-D marginal/conditional warp of the adaptive parameterization (Dupuy & Jakob 2018, §5:
+//! The 2-D marginal/conditional warp of the adaptive parameterization (Dupuy & Jakob 2018:
 //! a bilinearly interpolated density on [0, 1]^2, sampled by inverting a marginal CDF over rows
 //! and a conditional CDF over columns), optionally depending on extra parameters between whose
 //! discretised values it interpolates linearly. A port of `Marginal2D` in the reference evaluator
