@@ -2,6 +2,7 @@
 mod util;
 
 mod baselines;
+mod convert;
 mod data;
 mod devices;
 mod fetch_merl;

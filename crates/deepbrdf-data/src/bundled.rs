@@ -7,6 +7,9 @@
 //! | `merl` | 100 | MERL BRDF database (Matusik et al. 2003) |
 //! | `nielsen2015` | 8 | Nielsen, Jensen & Ramamoorthi 2015 |
 //! | `rgl` | 51 | RGL isotropic materials (Dupuy & Jakob 2018) |
+//!
+//! A fourth collection, `rgl-measured`, holds no networks: it is seven real RGL measurements
+//! (raw `.bsdf` files, [`crate::rgl::bundled`]), converted to the MERL grid on first use.
 
 use crate::error::{DataError, Result};
 use crate::nbrdf::{unpack, Network};
@@ -22,19 +25,27 @@ pub enum Collection {
     Nielsen2015,
     /// The 51 isotropic RGL materials.
     Rgl,
+    /// Seven real RGL measurements ([`crate::rgl::bundled`]), not networks.
+    RglMeasured,
 }
 
 impl Collection {
-    /// All collections, in lookup order.
+    /// The collections of networks, in lookup order.
     pub const ALL: [Collection; 3] = [Collection::Merl, Collection::Nielsen2015, Collection::Rgl];
 
-    /// The collection's name: `merl`, `nielsen2015` or `rgl`.
+    /// The collection's name: `merl`, `nielsen2015`, `rgl` or `rgl-measured`.
     pub fn name(self) -> &'static str {
         match self {
             Collection::Merl => "merl",
             Collection::Nielsen2015 => "nielsen2015",
             Collection::Rgl => "rgl",
+            Collection::RglMeasured => crate::rgl::bundled::COLLECTION,
         }
+    }
+
+    /// Whether the collection holds raw measurements rather than networks.
+    pub fn is_measured(self) -> bool {
+        self == Collection::RglMeasured
     }
 
     /// The folder of JSON networks this collection is packed from (under the NBRDF data folder).
@@ -43,6 +54,7 @@ impl Collection {
             Collection::Merl => "merl",
             Collection::Nielsen2015 => "nielsen2015",
             Collection::Rgl => "rgl-isotropic",
+            Collection::RglMeasured => "rgl-measured",
         }
     }
 
@@ -51,23 +63,30 @@ impl Collection {
         format!("{}.nbrdf", self.name())
     }
 
-    /// The embedded pack bytes.
-    pub fn pack_bytes(self) -> &'static [u8] {
+    /// The embedded pack bytes (none for the measured collection).
+    pub fn pack_bytes(self) -> Option<&'static [u8]> {
         match self {
-            Collection::Merl => include_bytes!("../assets/nbrdf/merl.nbrdf"),
-            Collection::Nielsen2015 => include_bytes!("../assets/nbrdf/nielsen2015.nbrdf"),
-            Collection::Rgl => include_bytes!("../assets/nbrdf/rgl.nbrdf"),
+            Collection::Merl => Some(include_bytes!("../assets/nbrdf/merl.nbrdf")),
+            Collection::Nielsen2015 => Some(include_bytes!("../assets/nbrdf/nielsen2015.nbrdf")),
+            Collection::Rgl => Some(include_bytes!("../assets/nbrdf/rgl.nbrdf")),
+            Collection::RglMeasured => None,
         }
     }
 
-    /// The collection's networks, sorted by name (unpacked once, then shared).
+    /// The collection's networks, sorted by name (unpacked once, then shared). An error for the
+    /// measured collection, which has none.
     pub fn materials(self) -> Result<&'static [Network]> {
         static CELLS: [OnceLock<std::result::Result<Vec<Network>, String>>; 3] =
             [OnceLock::new(), OnceLock::new(), OnceLock::new()];
+        let Some(pack) = self.pack_bytes() else {
+            return Err(DataError::Invalid(format!(
+                "{self} holds measurements, not networks (load its materials by name or as a dataset)"
+            )));
+        };
         let slot = &CELLS[self as usize];
         let unpacked = slot.get_or_init(|| {
             let origin = format!("<bundled {}>", self.pack_file_name());
-            unpack(self.pack_bytes(), Path::new(&origin)).map_err(|e| e.to_string())
+            unpack(pack, Path::new(&origin)).map_err(|e| e.to_string())
         });
         match unpacked {
             Ok(nets) => Ok(nets),
@@ -77,11 +96,17 @@ impl Collection {
 
     /// The names of the collection's materials, sorted.
     pub fn names(self) -> Result<Vec<&'static str>> {
+        if self.is_measured() {
+            return Ok(crate::rgl::bundled::names());
+        }
         Ok(self.materials()?.iter().map(Network::name).collect())
     }
 
-    /// The material called `name` in this collection, if any.
+    /// The network called `name` in this collection, if any (never in the measured one).
     pub fn get(self, name: &str) -> Result<Option<&'static Network>> {
+        if self.is_measured() {
+            return Ok(None);
+        }
         let nets = self.materials()?;
         Ok(nets.binary_search_by(|n| n.name().cmp(name)).ok().map(|i| &nets[i]))
     }
@@ -96,14 +121,16 @@ impl std::fmt::Display for Collection {
 impl std::str::FromStr for Collection {
     type Err = DataError;
 
-    /// Parses `merl`, `nielsen2015` or `rgl` (also `rgl-isotropic`), ignoring case.
+    /// Parses `merl`, `nielsen2015`, `rgl` (also `rgl-isotropic`) or `rgl-measured`, ignoring
+    /// case.
     fn from_str(s: &str) -> Result<Self> {
         match s.to_ascii_lowercase().as_str() {
             "merl" => Ok(Collection::Merl),
             "nielsen2015" => Ok(Collection::Nielsen2015),
             "rgl" | "rgl-isotropic" => Ok(Collection::Rgl),
+            "rgl-measured" => Ok(Collection::RglMeasured),
             _ => Err(DataError::Invalid(format!(
-                "unknown collection {s:?}: expected one of merl, nielsen2015, rgl"
+                "unknown collection {s:?}: expected one of merl, nielsen2015, rgl, rgl-measured"
             ))),
         }
     }
@@ -116,6 +143,12 @@ pub fn find_material(spec: &str) -> Result<(Collection, &'static Network)> {
         Some((col, name)) => (vec![col.parse::<Collection>()?], name),
         None => (Collection::ALL.to_vec(), spec),
     };
+    if collections.iter().any(|c| c.is_measured()) {
+        return Err(DataError::Invalid(format!(
+            "{spec:?} names a measurement, not a network (load it as a material, e.g. with \
+             `experiments info {spec}`, or write a MERL file with `experiments convert`)"
+        )));
+    }
     for &col in &collections {
         if let Some(net) = col.get(name)? {
             return Ok((col, net));
@@ -177,9 +210,11 @@ mod tests {
 
     #[test]
     fn names_parse_and_display() {
-        for col in Collection::ALL {
+        for col in Collection::ALL.into_iter().chain([Collection::RglMeasured]) {
             assert_eq!(col.to_string().parse::<Collection>().expect("parse"), col);
         }
+        assert!(Collection::RglMeasured.materials().is_err());
+        assert_eq!(Collection::RglMeasured.names().expect("names").len(), 7);
         assert_eq!("RGL".parse::<Collection>().expect("parse"), Collection::Rgl);
         assert!("mer".parse::<Collection>().is_err());
     }
@@ -197,6 +232,8 @@ mod tests {
         let err = find_material("merl/cardboard_rgb").expect_err("wrong collection").to_string();
         assert!(err.contains("no bundled material"), "{err}");
         assert!(find_material("nope/chrome").is_err());
+        let err = find_material("rgl-measured/paper_white_rgb").expect_err("no network");
+        assert!(err.to_string().contains("measurement, not a network"), "{err}");
     }
 
     /// The 20 reference evaluations computed by the data's authors in float64 from the original

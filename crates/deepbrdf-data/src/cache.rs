@@ -1,8 +1,10 @@
-//! On-disk cache of tabulated NBRDF tables, so each bundled material is tabulated once.
+//! On-disk cache of tabulated tables (NBRDF networks, and RGL measurements converted to the MERL
+//! grid), so each material is tabulated once.
 //!
 //! One file per material, `<dir>/tables/<name>-<key>.tab`, where `<key>` starts the hex
-//! SHA-256 of the network's parameters and [`TABULATOR_VERSION`]: a changed network or a changed
-//! tabulator gives a new key, so stale tables are never read (and are pruned when replaced).
+//! SHA-256 of the network's parameters and [`TABULATOR_VERSION`] (of an RGL file's bytes and
+//! [`RGL_TABULATOR_VERSION`]): a changed network, file or tabulator gives a new key, so stale
+//! tables are never read (and are pruned when replaced).
 //! Files are written to a temporary name and renamed into place. Reading checks the size, the
 //! header (magic, versions, key) and a SHA-256 of the values before trusting anything; a
 //! corrupt or truncated file is recomputed and replaced.
@@ -14,6 +16,7 @@ use crate::error::{DataError, Result};
 use crate::files::create_parent_and_write;
 use crate::merl::{MerlTable, VALUES};
 use crate::nbrdf::{tabulate, Network, TABULATOR_VERSION};
+use crate::rgl::{RglBrdf, RGL_TABULATOR_VERSION};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
@@ -83,9 +86,7 @@ impl Cache {
 
     /// The cache file of `net`, if caching is enabled.
     pub fn path_for(&self, net: &Network) -> Option<PathBuf> {
-        let key = hex::encode(Self::key(net));
-        let name = format!("{}-{}.tab", file_safe(net.name()), &key[..KEY_DIGITS]);
-        self.dir.as_ref().map(|d| d.join("tables").join(name))
+        self.path_of(net.name(), &Self::key(net))
     }
 
     /// The tabulated table of `net`, from the cache when a valid file exists, else tabulated and
@@ -96,18 +97,61 @@ impl Cache {
 
     /// Like [`Cache::tabulated`], also saying whether the cache was used.
     pub fn tabulated_with_outcome(&self, net: &Network) -> Result<(MerlTable, Outcome)> {
-        let Some(path) = self.path_for(net) else {
-            return Ok((tabulate(net)?, Outcome::Computed));
+        self.cached(net.name(), &Self::key(net), TABULATOR_VERSION, || tabulate(net))
+    }
+
+    /// The cache key of an RGL measurement: SHA-256 over the RGL tabulator version and the
+    /// `.bsdf` file's bytes.
+    pub fn rgl_key(bytes: &[u8]) -> [u8; 32] {
+        let mut h = Sha256::new();
+        h.update(b"deepbrdf rgl table");
+        h.update(RGL_TABULATOR_VERSION.to_le_bytes());
+        h.update(TABULATOR_VERSION.to_le_bytes());
+        h.update(bytes);
+        h.finalize().into()
+    }
+
+    /// The MERL table of the RGL measurement called `name` whose `.bsdf` file has `bytes`
+    /// (`origin` names it in errors): from the cache when a valid file exists, else parsed,
+    /// converted ([`crate::rgl::tabulate`]) and stored.
+    pub fn converted(
+        &self,
+        name: &str,
+        origin: &Path,
+        bytes: &[u8],
+    ) -> Result<(MerlTable, Outcome)> {
+        let key = Self::rgl_key(bytes);
+        self.cached(name, &key, RGL_TABULATOR_VERSION, || {
+            crate::rgl::tabulate(&RglBrdf::parse(origin, bytes)?)
+        })
+    }
+
+    /// The cache file of material `name` under `key`, if caching is enabled.
+    fn path_of(&self, name: &str, key: &[u8; 32]) -> Option<PathBuf> {
+        let key = hex::encode(key);
+        let file = format!("{}-{}.tab", file_safe(name), &key[..KEY_DIGITS]);
+        self.dir.as_ref().map(|d| d.join("tables").join(file))
+    }
+
+    /// A table from the cache file of (`name`, `key`) if valid, else from `compute` (stored).
+    fn cached(
+        &self,
+        name: &str,
+        key: &[u8; 32],
+        version: u32,
+        compute: impl FnOnce() -> Result<MerlTable>,
+    ) -> Result<(MerlTable, Outcome)> {
+        let Some(path) = self.path_of(name, key) else {
+            return Ok((compute()?, Outcome::Computed));
         };
-        let key = Self::key(net);
-        let outcome = match read_cached(&path, &key) {
+        let outcome = match read_cached(&path, key, version) {
             Ok(Some(table)) => return Ok((table, Outcome::Hit)),
             Ok(None) => Outcome::Computed,
             Err(_) => Outcome::Recomputed,
         };
-        let table = tabulate(net)?;
-        store(&path, &key, &table)?;
-        prune_stale(&path, net.name());
+        let table = compute()?;
+        store(&path, key, version, &table)?;
+        prune_stale(&path, name);
         Ok((table, outcome))
     }
 }
@@ -121,7 +165,7 @@ fn file_safe(name: &str) -> String {
 
 /// Reads a cached table: `Ok(None)` if there is no file, `Err` if it is not a valid table
 /// for `key`.
-fn read_cached(path: &Path, key: &[u8; 32]) -> Result<Option<MerlTable>> {
+fn read_cached(path: &Path, key: &[u8; 32], version: u32) -> Result<Option<MerlTable>> {
     use std::io::Read;
     let mut file = match std::fs::File::open(path) {
         Ok(f) => f,
@@ -140,7 +184,7 @@ fn read_cached(path: &Path, key: &[u8; 32]) -> Result<Option<MerlTable>> {
     let u32_at = |at: usize| {
         u32::from_le_bytes([header[at], header[at + 1], header[at + 2], header[at + 3]])
     };
-    if header[..8] != MAGIC || u32_at(8) != FORMAT_VERSION || u32_at(12) != TABULATOR_VERSION {
+    if header[..8] != MAGIC || u32_at(8) != FORMAT_VERSION || u32_at(12) != version {
         return Err(DataError::format(path, "not a cached table of this version"));
     }
     if header[16..48] != key[..] {
@@ -158,11 +202,11 @@ fn read_cached(path: &Path, key: &[u8; 32]) -> Result<Option<MerlTable>> {
 }
 
 /// Writes a cached table atomically.
-fn store(path: &Path, key: &[u8; 32], table: &MerlTable) -> Result<()> {
+fn store(path: &Path, key: &[u8; 32], version: u32, table: &MerlTable) -> Result<()> {
     let mut bytes = Vec::with_capacity(FILE_BYTES as usize);
     bytes.extend(MAGIC);
     bytes.extend(FORMAT_VERSION.to_le_bytes());
-    bytes.extend(TABULATOR_VERSION.to_le_bytes());
+    bytes.extend(version.to_le_bytes());
     bytes.extend(key);
     bytes.extend([0u8; 32]);
     bytes.extend(table.values().iter().flat_map(|v| v.to_le_bytes()));
@@ -240,7 +284,7 @@ mod tests {
 
         // A file holding another network's table under this key's name is not trusted.
         std::fs::copy(&new_path, &path).expect("copy");
-        assert!(read_cached(&path, &Cache::key(&net)).is_err());
+        assert!(read_cached(&path, &Cache::key(&net), TABULATOR_VERSION).is_err());
         let leftovers: Vec<_> = std::fs::read_dir(path.parent().expect("dir"))
             .expect("list")
             .flatten()

@@ -79,6 +79,9 @@ fn load_bundled(
     cache: &Cache,
     progress: &dyn Progress,
 ) -> Result<(Vec<String>, Vec<MerlTable>)> {
+    if collection.is_measured() {
+        return load_measured(cache, progress);
+    }
     let networks = collection.materials()?;
     progress.start(networks.len() as u64, &format!("tabulating {collection}"));
     let tables = networks
@@ -91,6 +94,44 @@ fn load_bundled(
         .collect::<Result<Vec<_>>>();
     progress.finish();
     Ok((networks.iter().map(|n| n.name().to_string()).collect(), tables?))
+}
+
+/// The bundled RGL measurements, converted to the MERL grid (cached).
+fn load_measured(cache: &Cache, progress: &dyn Progress) -> Result<(Vec<String>, Vec<MerlTable>)> {
+    let files = &crate::rgl::bundled::FILES;
+    progress.start(files.len() as u64, "converting rgl-measured");
+    let tables = files
+        .iter()
+        .map(|(name, _)| {
+            let table = load_measured_material(name, cache);
+            progress.advance(1);
+            table
+        })
+        .collect::<Result<Vec<_>>>();
+    progress.finish();
+    Ok((files.iter().map(|(n, _)| n.to_string()).collect(), tables?))
+}
+
+/// The bundled measurement `name`, converted to the MERL grid (cached).
+fn load_measured_material(name: &str, cache: &Cache) -> Result<MerlTable> {
+    let bytes = crate::rgl::bundled::bytes(name).ok_or_else(|| {
+        DataError::Invalid(format!(
+            "no measurement named {name:?} in rgl-measured: expected one of {}",
+            crate::rgl::bundled::names().join(", ")
+        ))
+    })?;
+    let origin = format!("<bundled rgl-measured/{name}.bsdf>");
+    Ok(cache.converted(name, Path::new(&origin), bytes)?.0)
+}
+
+/// An RGL `.bsdf` file converted to the MERL grid (cached under the file's stem).
+fn load_bsdf_file(path: &Path, cache: &Cache) -> Result<MerlTable> {
+    let (mut file, len) = crate::files::open_regular(path)?;
+    if len > crate::rgl::tensor::MAX_FILE_BYTES {
+        return Err(DataError::format(path, format!("{len} bytes: too large for a tensor file")));
+    }
+    let bytes = crate::files::read_exactly(&mut file, path, len as usize)?;
+    Ok(cache.converted(&material_name(path), path, &bytes)?.0)
 }
 
 /// The `*.binary` files of `dir`, sorted by file name. Errors for a missing or empty directory.
@@ -148,10 +189,18 @@ fn is_file_spec(spec: &str) -> bool {
     }
 }
 
-/// Loads one material: `spec` is a MERL `.binary` path, or a bundled material name (`chrome`,
-/// `merl/chrome`, `rgl/cardboard_rgb`). Returns the material's name and its table. Unknown names
-/// give an error listing close matches.
+/// Loads one material: `spec` is a MERL `.binary` path, an RGL `.bsdf` path (converted to the
+/// MERL grid and cached), or a bundled material name (`chrome`, `merl/chrome`,
+/// `rgl/cardboard_rgb`, `rgl-measured/paper_white_rgb`). Returns the material's name and its
+/// table. Unknown names give an error listing close matches.
 pub fn load_material(spec: &str, cache: &Cache) -> Result<(String, MerlTable)> {
+    if let Some(name) = spec.strip_prefix("rgl-measured/") {
+        return Ok((name.to_string(), load_measured_material(name, cache)?));
+    }
+    if spec.ends_with(".bsdf") {
+        let path = Path::new(spec);
+        return Ok((material_name(path), load_bsdf_file(path, cache)?));
+    }
     if is_file_spec(spec) {
         let path = Path::new(spec);
         return Ok((material_name(path), read_merl(path)?));

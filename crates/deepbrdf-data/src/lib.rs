@@ -15,6 +15,7 @@ pub mod merl;
 pub mod nbrdf;
 pub mod network_input;
 pub mod progress;
+pub mod rgl;
 pub mod summary;
 pub mod testing;
 

@@ -2,7 +2,7 @@
 //! cells, and the hemispherical albedo at normal incidence.
 
 use crate::merl::{cell_index, grid, MerlTable, CELLS, N_THETA_D, N_THETA_H};
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::PI;
 
 /// Statistics of a table; channel arrays are (R, G, B), values in 1/sr.
 #[derive(Debug, Clone, PartialEq)]
@@ -93,11 +93,12 @@ pub fn albedo_at_normal_incidence(table: &MerlTable) -> [f64; 3] {
     albedo
 }
 
-/// Bilinear interpolation at (theta_h, theta_d) radians, phi_d = 0, over valid cells.
+/// Bilinear interpolation at (theta_h, theta_d) radians over valid cells of the first phi_d
+/// column (its centre, phi_d = 0.5 degrees, stands for phi_d = 0).
 fn on_grid(table: &MerlTable, theta_h: f64, theta_d: f64) -> [f64; 3] {
-    // Continuous grid positions: theta_h = (i/90)^2 π/2, theta_d = j/90 π/2 (grid.rs).
-    let u = ((theta_h / FRAC_PI_2).max(0.0).sqrt() * N_THETA_H as f64).min((N_THETA_H - 1) as f64);
-    let v = (theta_d / FRAC_PI_2 * N_THETA_D as f64).min((N_THETA_D - 1) as f64);
+    // Continuous grid positions of the bin centres (grid.rs).
+    let u = crate::merl::coords::continuous_theta_h(theta_h);
+    let v = crate::merl::coords::continuous_theta_d(theta_d);
     let (i0, j0) = (u.floor() as usize, v.floor() as usize);
     let (fu, fv) = (u - i0 as f64, v - j0 as f64);
     let mut sum = [0f64; 3];
@@ -125,6 +126,7 @@ fn on_grid(table: &MerlTable, theta_h: f64, theta_d: f64) -> [f64; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::FRAC_PI_2;
 
     #[test]
     fn lambertian_albedo_is_its_reflectance() {

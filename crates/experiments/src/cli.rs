@@ -48,6 +48,8 @@ pub enum Command {
     Compare(commands::compare::Args),
     /// Render every material of a dataset on spheres, in one captioned contact sheet.
     Sheet(commands::sheet::Args),
+    /// Convert a real RGL measurement (.bsdf tensor file) to a MERL .binary file.
+    Convert(commands::convert::Args),
     /// Evaluate the PCA and IPCA baselines (§4): summary table, CSV, plots.
     Baselines(commands::baselines::Args),
 }

@@ -10,7 +10,8 @@ use std::path::{Path, PathBuf};
 
 #[derive(Debug, Clone, clap::Args)]
 pub struct DataArgs {
-    /// Bundled collection of materials: merl (100), nielsen2015 (8) or rgl (51).
+    /// Bundled collection of materials: merl (100), nielsen2015 (8), rgl (51 NBRDF fits) or
+    /// rgl-measured (7 real RGL measurements).
     #[arg(long, value_name = "NAME", default_value = "merl", conflicts_with = "data")]
     pub collection: Collection,
     /// Folder of MERL .binary files to use instead of a bundled collection (e.g. the real MERL

@@ -6,6 +6,7 @@ mod deep_method;
 mod device_arg;
 mod latent_file;
 mod mapped_input;
+mod measured_brdf;
 mod nested_baseline;
 mod progress;
 mod progress_log;

@@ -74,7 +74,8 @@ impl HalfDiff {
     }
 
     /// Continuous (fractional) indices (theta_h, theta_d, phi_d): the integer values are the
-    /// sample angles of [`crate::merl::grid`], so cell i is sampled at fractional index i.
+    /// sample angles (bin centres) of [`crate::merl::grid`], so cell i is sampled at fractional
+    /// index i.
     /// theta_h and theta_d are clamped to [0, 89]; phi_d lies in [0, 180) and wraps (180 = 0).
     #[inline]
     pub fn continuous_index(&self) -> [f64; 3] {
@@ -148,34 +149,36 @@ pub fn phi_d_index(phi_d: f64) -> usize {
     (fold_phi_d(phi_d) / PI * N_PHI_D as f64).min((N_PHI_D - 1) as f64) as usize
 }
 
-/// Fractional theta_h index `sqrt(theta_h / (pi/2)) * 90`, clamped to [0, 89]: the inverse of
-/// `theta_h = (i / 90)^2 * pi/2` ([`crate::merl::grid::theta_h_of`]).
+/// Fractional theta_h index `sqrt(theta_h / (pi/2)) * 90 - 1/2`, clamped to [0, 89]: the
+/// inverse of [`crate::merl::grid::theta_h_of`] (cell i's value stands for its bin centre, at
+/// fractional index i).
 #[inline]
 pub fn continuous_theta_h(theta_h: f64) -> f64 {
     if theta_h.is_nan() || theta_h <= 0.0 {
         return 0.0;
     }
-    ((theta_h / FRAC_PI_2).sqrt() * N_THETA_H as f64).min((N_THETA_H - 1) as f64)
+    ((theta_h / FRAC_PI_2).sqrt() * N_THETA_H as f64 - 0.5).clamp(0.0, (N_THETA_H - 1) as f64)
 }
 
-/// Fractional theta_d index `theta_d / (pi/2) * 90`, clamped to [0, 89]: the inverse of
+/// Fractional theta_d index `theta_d / (pi/2) * 90 - 1/2`, clamped to [0, 89]: the inverse of
 /// [`crate::merl::grid::theta_d_of`].
 #[inline]
 pub fn continuous_theta_d(theta_d: f64) -> f64 {
     if theta_d.is_nan() || theta_d <= 0.0 {
         return 0.0;
     }
-    (theta_d / FRAC_PI_2 * N_THETA_D as f64).min((N_THETA_D - 1) as f64)
+    (theta_d / FRAC_PI_2 * N_THETA_D as f64 - 0.5).clamp(0.0, (N_THETA_D - 1) as f64)
 }
 
-/// Fractional phi_d index `fold(phi_d) / pi * 180` in [0, 180): the inverse of
-/// [`crate::merl::grid::phi_d_of`]; 180 would be index 0 again (phi_d is pi-periodic).
+/// Fractional phi_d index `fold(phi_d) / pi * 180 - 1/2`, wrapped into [0, 180): the inverse of
+/// [`crate::merl::grid::phi_d_of`]; phi_d is pi-periodic after folding, so fractional index -1/2
+/// (phi_d = 0) lies halfway between cell 179 and cell 0.
 #[inline]
 pub fn continuous_phi_d(phi_d: f64) -> f64 {
     if phi_d.is_nan() {
         return 0.0;
     }
-    let u = fold_phi_d(phi_d) / PI * N_PHI_D as f64;
+    let u = (fold_phi_d(phi_d) / PI * N_PHI_D as f64 - 0.5).rem_euclid(N_PHI_D as f64);
     if u >= N_PHI_D as f64 {
         0.0
     } else {
@@ -315,14 +318,22 @@ mod tests {
             let u = continuous_theta_h(theta_h_of(i));
             assert!((u - i as f64).abs() < 1e-9, "{i}: {u}");
             assert!((continuous_theta_d(theta_d_of(i)) - i as f64).abs() < 1e-9);
-            // Slightly inside the cell: the reference reader's index is the cell.
-            assert_eq!(theta_h_index(theta_h_of(i) + 1e-9), i);
-            assert_eq!(theta_d_index(theta_d_of(i) + 1e-9), i);
+            // The sample angle is the bin centre: the reference reader's index is the cell, and
+            // so it is a third of a bin either side.
+            assert_eq!(theta_h_index(theta_h_of(i)), i);
+            assert_eq!(theta_d_index(theta_d_of(i)), i);
+            let third = FRAC_PI_2 / 90.0 / 3.0;
+            assert_eq!(theta_d_index(theta_d_of(i) + third), i);
+            assert_eq!(theta_d_index(theta_d_of(i) - third), i);
         }
         for k in 0..180 {
             assert!((continuous_phi_d(phi_d_of(k)) - k as f64).abs() < 1e-9);
-            assert_eq!(phi_d_index(phi_d_of(k) + 1e-9), k);
+            assert_eq!(phi_d_index(phi_d_of(k)), k);
+            assert_eq!(phi_d_index(phi_d_of(k) + PI / 180.0 / 3.0), k);
+            assert_eq!(phi_d_index(phi_d_of(k) - PI / 180.0 / 3.0), k);
         }
+        // phi_d = 0 is the edge between the last and the first cell.
+        assert!((continuous_phi_d(0.0) - 179.5).abs() < 1e-9);
         let c = continuous_phi_d(PI - 1e-15);
         assert!((0.0..180.0).contains(&c));
     }

@@ -1,8 +1,12 @@
 //! The MERL sampling grid: its size and cell order, the angles at which each cell is sampled,
 //! which cells lie above the horizon and the cosine weight of each cell (the one home of these
-//! facts). Angles follow the conventions of the NBRDF tabulation (cell lower edges):
-//! theta_h = (i / 90)^2 * pi/2 (MERL's square-root warp), theta_d = j / 90 * pi/2,
-//! phi_d = k / 180 * pi.
+//! facts). MERL's reference reader `BRDFRead.cpp` bins a direction pair into cell
+//! `floor(sqrt(theta_h / 90deg) * 90)`, `floor(theta_d / 90deg * 90)`, `floor(phi_d / 180deg *
+//! 180)`, so a stored value stands for its bin: cells are sampled at their bin centres,
+//! theta_h = ((i + 1/2) / 90)^2 * pi/2 (the centre in MERL's square-root warp),
+//! theta_d = (j + 1/2) / 90 * pi/2, phi_d = (k + 1/2) / 180 * pi. (The NBRDF tabulation, and
+//! this project before, used the lower edges, which shifts every value by half a cell for every
+//! other MERL reader.)
 
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -18,6 +22,8 @@ pub const N_PHI_D: usize = 180;
 pub const CELLS: usize = N_THETA_H * N_THETA_D * N_PHI_D;
 /// Values per table, all three channels: 4,374,000.
 pub const VALUES: usize = 3 * CELLS;
+/// Cells in one theta_h row of the grid (all theta_d and phi_d): 16,200.
+pub const ROW: usize = N_THETA_D * N_PHI_D;
 
 /// Flat index of a cell within one channel, in MERL's file order
 /// (`phi_d + theta_d * 180 + theta_h * 180 * 90`).
@@ -32,23 +38,23 @@ pub fn cell_coords(cell: usize) -> (usize, usize, usize) {
     (cell / (N_THETA_D * N_PHI_D), (cell / N_PHI_D) % N_THETA_D, cell % N_PHI_D)
 }
 
-/// theta_h (radians) of index `i`: the inverse of MERL's square-root warp.
+/// theta_h (radians) of index `i`: the bin centre in MERL's square-root warp.
 #[inline]
 pub fn theta_h_of(i: usize) -> f64 {
-    let u = i as f64 / N_THETA_H as f64;
+    let u = (i as f64 + 0.5) / N_THETA_H as f64;
     u * u * FRAC_PI_2
 }
 
-/// theta_d (radians) of index `j`.
+/// theta_d (radians) of index `j`: its bin centre.
 #[inline]
 pub fn theta_d_of(j: usize) -> f64 {
-    j as f64 / N_THETA_D as f64 * FRAC_PI_2
+    (j as f64 + 0.5) / N_THETA_D as f64 * FRAC_PI_2
 }
 
-/// phi_d (radians) of index `k`, in [0, pi).
+/// phi_d (radians) of index `k`, in (0, pi): its bin centre.
 #[inline]
 pub fn phi_d_of(k: usize) -> f64 {
-    k as f64 / N_PHI_D as f64 * PI
+    (k as f64 + 0.5) / N_PHI_D as f64 * PI
 }
 
 /// Whether both directions of a cell lie strictly above the horizon.
@@ -63,7 +69,8 @@ pub fn angles_are_valid(theta_h: f64, theta_d: f64, phi_d: f64) -> bool {
     a - b > 0.0
 }
 
-/// Whether the cell with indices (i, j, k) lies above the horizon at its sample angles.
+/// Whether the cell with indices (i, j, k) lies above the horizon at its sample angles (its bin
+/// centre).
 #[inline]
 pub fn cell_is_valid(i: usize, j: usize, k: usize) -> bool {
     angles_are_valid(theta_h_of(i), theta_d_of(j), phi_d_of(k))

@@ -175,10 +175,10 @@ mod tests {
     /// `merl::grid` extended to non-integer indices.
     fn at_index(f: &impl Fn([f64; 3], [f64; 3]) -> [f64; 3], u: [f64; 3]) -> [f64; 3] {
         let a = HalfDiff {
-            theta_h: (u[0] / 90.0).powi(2) * FRAC_PI_2,
+            theta_h: ((u[0] + 0.5) / 90.0).powi(2) * FRAC_PI_2,
             phi_h: 0.0,
-            theta_d: u[1] / 90.0 * FRAC_PI_2,
-            phi_d: u[2] / 180.0 * PI,
+            theta_d: (u[1] + 0.5) / 90.0 * FRAC_PI_2,
+            phi_d: (u[2] + 0.5) / 180.0 * PI,
         };
         let (wi, wo) = a.to_dirs();
         f(wi, wo)
@@ -235,14 +235,53 @@ mod tests {
         assert!(err_interp < 0.2 * err_nearest, "{err_interp} vs {err_nearest}");
     }
 
+    /// The MERL convention: a value stands for its bin's centre. A GGX lobe tabulated at the
+    /// centres (the grid's sample angles) matches the analytic lobe better, through both
+    /// lookups, than the same lobe tabulated at the bins' lower edges (the NBRDF convention this
+    /// project used before). Observed with this seed (mean relative error): interpolated 0.0009
+    /// at centres vs 0.0186 at edges, nearest 0.0140 vs 0.0219.
+    #[test]
+    fn ggx_tabulated_at_bin_centres_beats_lower_edges() {
+        let lobe = Ggx { alpha: 0.2, f0: [0.05, 0.4, 0.9], diffuse: [0.05, 0.02, 0.0] };
+        let f = |wi: [f64; 3], wo: [f64; 3]| ggx(&lobe, wi, wo);
+        let centres = tabulate(f);
+        let edges = MerlTable::from_fn(|h, d, p| {
+            let a = HalfDiff {
+                theta_h: (h as f64 / 90.0).powi(2) * FRAC_PI_2,
+                phi_h: 0.0,
+                theta_d: d as f64 / 90.0 * FRAC_PI_2,
+                phi_d: p as f64 / 180.0 * PI,
+            };
+            let (wi, wo) = a.to_dirs();
+            f(wi, wo).map(|v| v as f32)
+        });
+        let mut err = [[0f64; 2]; 2]; // [interpolated, nearest] x [centres, edges]
+        let pairs = random_pairs(11, 20_000, 0.2);
+        for &(wi, wo) in &pairs {
+            let exact = f(wi, wo);
+            for (t, table) in [&centres, &edges].into_iter().enumerate() {
+                let (l, n) = (table.lookup_interpolated(wi, wo), table.lookup_nearest(wi, wo));
+                for c in 0..3 {
+                    err[0][t] += (f64::from(l[c]) - exact[c]).abs() / exact[c];
+                    err[1][t] += (f64::from(n[c]) - exact[c]).abs() / exact[c];
+                }
+            }
+        }
+        let err = err.map(|e| e.map(|x| x / (3 * pairs.len()) as f64));
+        eprintln!("mean relative error, interpolated: centres {:.4} edges {:.4}; nearest: centres {:.4} edges {:.4}", err[0][0], err[0][1], err[1][0], err[1][1]);
+        assert!(err[0][0] < 0.2 * err[0][1], "interpolated: {:?}", err[0]);
+        assert!(err[1][0] < err[1][1], "nearest: {:?}", err[1]);
+    }
+
     #[test]
     fn interpolation_wraps_phi_d_and_skips_invalid_cells() {
         // A table that depends on phi_d only, as cos(2 phi_d) + 2 (pi-periodic).
         let table = MerlTable::from_fn(|_, _, p| {
             [(2.0 * crate::merl::grid::phi_d_of(p)).cos() as f32 + 2.0; 3]
         });
-        // Between cell 179 (phi_d 179 deg) and cell 0 (180 = 0 deg): average of both.
-        let a = HalfDiff { theta_h: 0.3, phi_h: 0.0, theta_d: 0.4, phi_d: PI / 180.0 * 179.5 };
+        // Between cell 179 (centre 179.5 deg) and cell 0 (centre 0.5 = 180.5 deg): at 180 = 0
+        // deg, the average of both.
+        let a = HalfDiff { theta_h: 0.3, phi_h: 0.0, theta_d: 0.4, phi_d: PI };
         let (wi, wo) = a.to_dirs();
         let got = table.lookup_interpolated(wi, wo)[0];
         let want = 0.5 * (table.rgb(0, 0, 179)[0] + table.rgb(0, 0, 0)[0]);

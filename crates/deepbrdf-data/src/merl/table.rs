@@ -5,7 +5,7 @@
 //! the channel's colour scale ([`MERL_SCALE`]). Cells where the incoming or outgoing direction is
 //! below the horizon are invalid; they hold a negative value, as in MERL's own files.
 
-use super::grid::{cell_coords, cell_index, cell_is_valid, CELLS, VALUES};
+use super::grid::{cell_coords, cell_index, cell_is_valid, CELLS, ROW, VALUES};
 use crate::error::{DataError, Result};
 
 /// Colour scales of MERL's reference reader (`BRDFRead.cpp`, Matusik et al. 2003): the stored value
@@ -48,6 +48,23 @@ impl MerlTable {
             return Err(DataError::Invalid(format!("value {i} is {} (not finite)", values[i])));
         }
         Ok(Self { values })
+    }
+
+    /// A table filled one theta_h row at a time, rows in parallel (rayon): `fill(i, [r, g, b])`
+    /// writes row `i` of the three channels ([`ROW`] cells each, preset to [`INVALID_VALUE`]).
+    /// Rows are independent, so the table does not depend on the thread count. Fails if a value
+    /// is non-finite (see [`MerlTable::from_values`]).
+    pub fn from_par_rows(fill: impl Fn(usize, [&mut [f32]; 3]) + Sync) -> Result<Self> {
+        use rayon::prelude::*;
+        let mut values = vec![INVALID_VALUE; VALUES];
+        let (r, rest) = values.split_at_mut(CELLS);
+        let (g, b) = rest.split_at_mut(CELLS);
+        r.par_chunks_mut(ROW)
+            .zip(g.par_chunks_mut(ROW))
+            .zip(b.par_chunks_mut(ROW))
+            .enumerate()
+            .for_each(|(i, ((r, g), b))| fill(i, [r, g, b]));
+        Self::from_values(values)
     }
 
     /// Builds a table by evaluating `f(theta_h, theta_d, phi_d) -> rgb` (indices) at valid cells;

@@ -10,12 +10,13 @@
 
 use super::network::{Network, HIDDEN, INPUTS, OUTPUTS};
 use crate::error::{DataError, Result};
-use crate::merl::{grid, MerlTable, CELLS, INVALID_VALUE, N_PHI_D, N_THETA_D, N_THETA_H, VALUES};
-use rayon::prelude::*;
+use crate::merl::grid::ROW;
+use crate::merl::{grid, MerlTable, N_PHI_D, N_THETA_D, N_THETA_H};
 
 /// Version of the tabulation procedure. Bump it whenever the values this module produces change
 /// (sample angles, clamping, arithmetic), so cached tables are recomputed.
-pub const TABULATOR_VERSION: u32 = 1;
+/// Version 2: cells sampled at their bin centres ([`grid`]), no longer at the lower edges.
+pub const TABULATOR_VERSION: u32 = 2;
 
 /// Cells evaluated together in one structure-of-arrays block.
 const BLOCK: usize = 64;
@@ -26,8 +27,6 @@ const CHUNKS: usize = BLOCK / LANES;
 /// `N` values for each cell of a block: `v[n][chunk][lane]` is value `n` of cell
 /// `chunk * LANES + lane`.
 type Lanes<const N: usize> = [[[f32; LANES]; CHUNKS]; N];
-/// Cells in one theta_h row of the grid (all theta_d and phi_d).
-const ROW: usize = N_THETA_D * N_PHI_D;
 
 /// Sines and cosines of the grid's sample angles, in f64 then rounded once to f32.
 struct GridTrig {
@@ -98,19 +97,6 @@ fn forward_block(net: &Network, x: &Lanes<INPUTS>, out: &mut Lanes<OUTPUTS>) {
     dense(&net.w3, &net.b3, &h2, out, |a| a);
 }
 
-/// The validity of every cell ([`grid::cell_is_valid`]), computed once per process.
-fn valid_cells() -> &'static [bool] {
-    static MASK: std::sync::OnceLock<Vec<bool>> = std::sync::OnceLock::new();
-    MASK.get_or_init(|| {
-        (0..CELLS)
-            .map(|cell| {
-                let (i, j, k) = crate::merl::cell_coords(cell);
-                grid::cell_is_valid(i, j, k)
-            })
-            .collect()
-    })
-}
-
 /// [`forward_block`] as a [`pulp::WithSimd`] operation: `Arch::dispatch` runs it inside a
 /// function compiled for the detected instruction set, with the forward pass inlined into it.
 struct ForwardOp<'a> {
@@ -145,7 +131,7 @@ fn tabulate_row(net: &Network, trig: &GridTrig, i: usize, rows: [&mut [f32]; 3])
         }
         block.len = 0;
     };
-    let valid = &valid_cells()[i * ROW..(i + 1) * ROW];
+    let valid = &grid::valid_mask()[i * ROW..(i + 1) * ROW];
     for j in 0..N_THETA_D {
         let (sd, cd) = (trig.sin_d[j], trig.cos_d[j]);
         for k in 0..N_PHI_D {
@@ -174,15 +160,7 @@ fn tabulate_row(net: &Network, trig: &GridTrig, i: usize, rows: [&mut [f32]; 3])
 /// Runs in parallel over theta_h rows. Fails if the network produces non-finite values.
 pub fn tabulate(net: &Network) -> Result<MerlTable> {
     let trig = GridTrig::new();
-    let mut values = vec![INVALID_VALUE; VALUES];
-    let (r, rest) = values.split_at_mut(CELLS);
-    let (g, b) = rest.split_at_mut(CELLS);
-    r.par_chunks_mut(ROW)
-        .zip(g.par_chunks_mut(ROW))
-        .zip(b.par_chunks_mut(ROW))
-        .enumerate()
-        .for_each(|(i, ((r, g), b))| tabulate_row(net, &trig, i, [r, g, b]));
-    MerlTable::from_values(values).map_err(|e| {
+    MerlTable::from_par_rows(|i, rows| tabulate_row(net, &trig, i, rows)).map_err(|e| {
         DataError::Invalid(format!("network {} tabulates to an invalid table: {e}", net.name()))
     })
 }
@@ -190,7 +168,7 @@ pub fn tabulate(net: &Network) -> Result<MerlTable> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::merl::{cell_coords, cell_index};
+    use crate::merl::{cell_coords, cell_index, CELLS, INVALID_VALUE};
     use crate::nbrdf::network::PARAMETERS;
     use rand::{Rng, SeedableRng};
 

@@ -2,13 +2,24 @@
 //! paper's image-space error), RMSE and PSNR of the tonemapped images, and writes a false-colour
 //! difference image.
 use crate::data_args::CacheArg;
+use crate::measured_brdf::MeasuredBrdf;
 use crate::scene_args::SceneArgs;
-use anyhow::Context;
+use anyhow::{bail, Context};
 use deepbrdf_data::dataset::load_material;
+use deepbrdf_data::rgl::{bundled, RglBrdf};
 use deepbrdf_data::Progress;
 use deepbrdf_eval::metrics::{compare_images, difference_image};
 use deepbrdf_render::{render, MerlBrdf};
 use std::path::PathBuf;
+
+/// The RGL evaluator of `spec`: a `.bsdf` file or `rgl-measured/NAME`.
+fn load_evaluator(spec: &str) -> anyhow::Result<RglBrdf> {
+    match spec.strip_prefix("rgl-measured/") {
+        Some(name) => Ok(bundled::load(name)?),
+        None if spec.ends_with(".bsdf") => Ok(RglBrdf::read(spec)?),
+        None => bail!("--evaluator needs a .bsdf file or rgl-measured/NAME as B, not '{spec}'"),
+    }
+}
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -22,6 +33,11 @@ pub struct Args {
     /// Error at which the colour map saturates, relative to A's mean pixel value on the object.
     #[arg(long, default_value_t = 0.5)]
     pub scale: f64,
+    /// Render B straight from the RGL evaluator instead of its MERL table (B must be a `.bsdf`
+    /// file or an `rgl-measured/NAME`): `compare rgl-measured/X rgl-measured/X --evaluator`
+    /// measures what converting X to the MERL grid changes in the image.
+    #[arg(long)]
+    pub evaluator: bool,
     #[command(flatten)]
     pub scene: SceneArgs,
     #[command(flatten)]
@@ -39,8 +55,15 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     // difference is the materials', not Monte Carlo noise.
     let brdf_a = MerlBrdf::new(&a);
     let image_a = render(&setup.scene, &brdf_a, &setup.settings, progress)?;
-    let brdf_b = MerlBrdf::new_sampled(&b, brdf_a.sampling().clone());
-    let image_b = render(&setup.scene, &brdf_b, &setup.settings, progress)?;
+    let image_b = if args.evaluator {
+        let measured = load_evaluator(&args.b)?;
+        let brdf = MeasuredBrdf { brdf: &measured, sampling: &brdf_a };
+        render(&setup.scene, &brdf, &setup.settings, progress)?
+    } else {
+        let brdf_b = MerlBrdf::new_sampled(&b, brdf_a.sampling().clone());
+        render(&setup.scene, &brdf_b, &setup.settings, progress)?
+    };
+    let name_b = if args.evaluator { format!("{name_b} (evaluator)") } else { name_b };
     let c = compare_images(&image_b, &image_a, &setup.tonemap)?;
     difference_image(&image_b, &image_a, args.scale)?.write_png(&args.output)?;
     println!(

@@ -37,9 +37,14 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         load_material(&spec, &cache).with_context(|| format!("cannot describe {spec}"))?;
     let path = Path::new(&spec);
     println!("material      {name}");
+    let measured = spec.starts_with("rgl-measured/") || spec.ends_with(".bsdf");
     if path.is_file() {
         let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
-        println!("source        {} ({len} bytes, MERL .binary)", path.display());
+        let format =
+            if measured { "RGL .bsdf, converted to the MERL grid" } else { "MERL .binary" };
+        println!("source        {} ({len} bytes, {format})", path.display());
+    } else if measured {
+        println!("source        bundled RGL measurement {spec}, converted to the MERL grid");
     } else {
         println!("source        bundled NBRDF network {spec}, tabulated onto the MERL grid");
     }

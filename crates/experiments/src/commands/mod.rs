@@ -5,6 +5,7 @@ use crate::progress::Bars;
 pub mod baselines;
 pub mod bench;
 pub mod compare;
+pub mod convert;
 pub mod decode;
 pub mod devices;
 pub mod encode;
@@ -35,6 +36,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::SweepK(args) => sweep_k::run(args, cli.quiet, &progress),
         Command::Render(args) => render::run(args, &progress),
         Command::Compare(args) => compare::run(args, &progress),
+        Command::Convert(args) => convert::run(args, &progress),
         Command::Sheet(args) => sheet::run(args, &progress),
         Command::Baselines(args) => baselines::run(args, &progress),
     }

@@ -2,6 +2,7 @@
 //! checked by these commands, not by timed tests).
 use deepbrdf_data::Progress;
 
+pub mod convert;
 pub mod io;
 pub mod lookup;
 pub mod model;
@@ -27,6 +28,9 @@ pub enum What {
     /// DeepBRDF training seconds per BRDF (cpu and paper presets) and decode seconds
     /// (target: decoding <= 0.15 s on 2 cores).
     Model(model::Args),
+    /// Converting RGL measurements (.bsdf) to the MERL grid (target: <= 10 s per file on 2
+    /// cores).
+    Convert(convert::Args),
     /// Renderer speed: MERL lookups per second and images per second (target: a 256x256 sphere
     /// of a tabulated MERL material under sun and sky at 64 spp in < 0.5 s on 2 cores).
     Render(render::Args),
@@ -43,5 +47,6 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         What::Model(a) => model::run(a, progress),
         What::Render(a) => render::run(a, progress),
         What::RenderNoise(a) => render_noise::run(a, progress),
+        What::Convert(a) => convert::run(a, progress),
     }
 }
