@@ -10,9 +10,11 @@
 
 mod fit;
 mod method;
+mod report;
 
 pub use fit::{fit, AttributeFit, FitConfig};
 pub use method::{AttributeCodec, AttributeMethod};
+pub use report::{csv, markdown, summary, write_csv, AttributeRow};
 
 use crate::error::{EvalError, Result};
 use deepbrdf_data::merl::coords::HalfDiff;

@@ -12,6 +12,7 @@ pub use deepbrdf_data::mapping::MedianReference;
 pub use measures::{Measure, Original, Yardstick};
 pub use modes::{Fold, Mode};
 pub use report::{FitTiming, Record, Results};
+pub(crate) use report::csv_field;
 
 use crate::error::{EvalError, Result};
 use crate::metrics::{ImageRelae, ImageRelaeConfig};
