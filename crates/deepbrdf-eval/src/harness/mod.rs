@@ -11,8 +11,8 @@ pub use codec::{Codec, Method, TrainingSet};
 pub use deepbrdf_data::mapping::MedianReference;
 pub use measures::{Measure, Original, Yardstick};
 pub use modes::{Fold, Mode};
-pub use report::{FitTiming, Record, Results};
 pub(crate) use report::csv_field;
+pub use report::{FitTiming, Record, Results};
 
 use crate::error::{EvalError, Result};
 use crate::metrics::{ImageRelae, ImageRelaeConfig};
