@@ -7,6 +7,7 @@ pub mod error;
 pub mod fetch;
 pub mod files;
 pub mod layout;
+pub mod lock;
 pub mod mapping;
 pub mod merl;
 pub mod nbrdf;

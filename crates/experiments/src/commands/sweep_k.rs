@@ -166,7 +166,8 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
     let kind = crate::device_arg::kind()?;
     let device = crate::device_arg::device()?;
     let out = args.out_dir();
-    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    // Held until the sweep ends: a second run on the same folder is refused (issue 15).
+    let _lock = deepbrdf_data::lock::FolderLock::acquire(&out)?;
     let models_dir = out.join("models");
 
     let data = args.load_data(progress)?;
