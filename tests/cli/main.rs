@@ -1,6 +1,7 @@
 //! End-to-end tests of the `experiments` command line, compiled as one test binary.
 mod util;
 
+mod attributes;
 mod baselines;
 mod convert;
 mod data;

@@ -52,6 +52,9 @@ pub enum Command {
     Convert(commands::convert::Args),
     /// Evaluate the PCA and IPCA baselines (§4): summary table, CSV, plots.
     Baselines(commands::baselines::Args),
+    /// Estimate the 7 editable attributes (§5.1: diffuse and specular albedo RGB, GGX
+    /// roughness) of materials by a Lambertian + GGX fit; CSV and table.
+    Attributes(commands::attributes::Args),
 }
 
 fn parse_device(s: &str) -> Result<deepbrdf_model::DeviceKind, String> {

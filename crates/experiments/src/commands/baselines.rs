@@ -6,6 +6,7 @@ use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::dataset::{DataSource, Dataset};
 use deepbrdf_data::Progress;
+use deepbrdf_eval::attributes::AttributeMethod;
 use deepbrdf_eval::baseline::BaselineMethod;
 use deepbrdf_eval::harness::{self, HarnessConfig, Materials, Measure, Method, Mode};
 use std::path::{Path, PathBuf};
@@ -35,6 +36,10 @@ pub struct Args {
     /// (renders the original and each reconstruction: ~0.3 s of CPU per pair).
     #[arg(long, value_delimiter = ',', default_value = "mapped_mse,cos_rmse")]
     pub measures: Vec<Measure>,
+    /// Methods (comma-separated): pca, ipca, ggx (the 7-number Lambertian + GGX attribute fit,
+    /// `deepbrdf_eval::attributes`; needs --k 7).
+    #[arg(long, value_name = "NAME,...", value_delimiter = ',', default_value = "pca,ipca")]
+    pub methods: Vec<String>,
     /// Generalize mode: the bundled collections to evaluate on (comma-separated).
     #[arg(long, value_name = "NAME,...", value_delimiter = ',', default_value = "nielsen2015,rgl")]
     pub eval_collections: Vec<Collection>,
@@ -68,6 +73,14 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     }
     if args.mode != Mode::Generalize && args.eval_collections != default_eval_collections() {
         bail!("--eval-collections is for generalize mode only");
+    }
+    for m in &args.methods {
+        if !["pca", "ipca", "ggx"].contains(&m.as_str()) {
+            bail!("unknown method '{m}' (pca, ipca, ggx)");
+        }
+    }
+    if args.methods.iter().any(|m| m == "ggx") && args.ks != [7] {
+        bail!("the ggx method has exactly 7 parameters: run it with --k 7");
     }
     let out = args.out.clone().unwrap_or_else(|| default_out(args.mode));
     // Held until the run ends: a second run on the same folder is refused (issue 15).
@@ -109,7 +122,16 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
 
     let train_label = format!("{} ({} materials)", train.label, train.len());
     let eval_label = eval.as_ref().map(|e| format!("{} ({} materials)", e.label, e.len()));
-    let methods: [&dyn Method; 2] = [&pca, &ipca];
+    let ggx = AttributeMethod::default();
+    let methods: Vec<&dyn Method> = args
+        .methods
+        .iter()
+        .map(|m| match m.as_str() {
+            "pca" => &pca as &dyn Method,
+            "ipca" => &ipca,
+            _ => &ggx,
+        })
+        .collect();
     let results = harness::run(
         &methods,
         &config,
@@ -123,7 +145,12 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     )?;
     results.write(&out).with_context(|| format!("writing the results to {}", out.display()))?;
     if let Some(dir) = &args.save_basis {
-        save_bases(dir, &[&pca, &ipca])?;
+        let kept: Vec<&BaselineMethod> = [("pca", &pca), ("ipca", &ipca)]
+            .into_iter()
+            .filter(|(name, _)| args.methods.iter().any(|m| m == name))
+            .map(|(_, m)| m)
+            .collect();
+        save_bases(dir, &kept)?;
     }
 
     println!(

@@ -2,6 +2,7 @@
 use crate::cli::{Cli, Command};
 use crate::progress::Bars;
 
+pub mod attributes;
 pub mod baselines;
 pub mod bench;
 pub mod compare;
@@ -39,5 +40,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Convert(args) => convert::run(args, &progress),
         Command::Sheet(args) => sheet::run(args, &progress),
         Command::Baselines(args) => baselines::run(args, &progress),
+        Command::Attributes(args) => attributes::run(args, &progress),
     }
 }
