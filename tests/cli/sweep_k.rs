@@ -24,6 +24,19 @@ fn tiny_config(path: &Path) {
     config.save(path).expect("writing the training configuration");
 }
 
+/// `sweep-k` on `data` at k = 1, 2 with the training configuration `config` into `out`, the
+/// Fig. 2 picture of m1, then `extra`.
+fn sweep_args(data: &Path, config: &Path, out: &Path, extra: &[&str]) -> Vec<String> {
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let mut args: Vec<String> = ["sweep-k", "--data", &s(data), "--ks", "1,2"]
+        .into_iter()
+        .chain(["--train-config", &s(config), "--out", &s(out), "--fig2-material", "m1"])
+        .map(str::to_string)
+        .collect();
+    args.extend(extra.iter().map(|a| a.to_string()));
+    args
+}
+
 #[test]
 fn sweep_k_writes_results_and_reuses_trained_models() {
     let dir = tempfile::tempdir().unwrap();
@@ -34,25 +47,10 @@ fn sweep_k_writes_results_and_reuses_trained_models() {
     std::fs::write(&readme, "# x\n<!-- sweep-k:begin -->\nold\n<!-- sweep-k:end -->\nend\n")
         .unwrap();
     let out = dir.path().join("out");
-    let s = |p: &Path| p.to_str().unwrap().to_string();
-    let args = [
-        "sweep-k".to_string(),
-        "--data".into(),
-        s(&data),
-        "--ks".into(),
-        "1,2".into(),
-        "--train-config".into(),
-        s(&config),
-        "--out".into(),
-        s(&out),
-        "--fig2-ks".into(),
-        "1,2".into(),
-        "--fig2-material".into(),
-        "m1".into(),
-        "--update-readme".into(),
-        s(&readme),
-    ];
-    let args: Vec<&str> = args.iter().map(|a| a.as_str()).collect();
+    let readme_arg = readme.to_str().unwrap().to_string();
+    let args =
+        sweep_args(&data, &config, &out, &["--fig2-ks", "1,2", "--update-readme", &readme_arg]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
 
     let first = util::run_in(dir.path(), &args);
     assert!(first.status.success(), "{}", util::stderr(&first));
@@ -149,27 +147,11 @@ fn sweep_k_with_the_cpu_preset_network_beats_pca_and_is_thread_count_independent
     let data = util::write_data(dir.path(), 3);
     let config = dir.path().join("spectral.json");
     spectral_config(&config);
-    let s = |p: &Path| p.to_str().unwrap().to_string();
     let mut outputs = Vec::new();
     for (threads, out) in [(1, "one"), (3, "three")] {
         let out = dir.path().join(out);
-        let args = [
-            "sweep-k".to_string(),
-            "--data".into(),
-            s(&data),
-            "--ks".into(),
-            "1,2".into(),
-            "--train-config".into(),
-            s(&config),
-            "--out".into(),
-            s(&out),
-            "--measures".into(),
-            "mapped_mse,cos_rmse".into(),
-            "--fig2-ks".into(),
-            "2".into(),
-            "--fig2-material".into(),
-            "m1".into(),
-        ];
+        let extra = ["--measures", "mapped_mse,cos_rmse", "--fig2-ks", "2"];
+        let args = sweep_args(&data, &config, &out, &extra);
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
         let run = util::run_on_threads(dir.path(), &args, threads);
         assert!(run.status.success(), "{}", util::stderr(&run));
