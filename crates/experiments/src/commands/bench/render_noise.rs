@@ -3,7 +3,9 @@
 //! under a constant environment, prints seconds per image, the relative noise (standard deviation
 //! over fully covered pixels of the difference of two seeds' renders, divided by sqrt(2) and by
 //! the mean pixel value) and the efficiency `1 / (noise^2 x seconds)`, which does not depend on
-//! the sample count for an unbiased estimator.
+//! the sample count for an unbiased estimator; also per CPU second (all threads together), which
+//! other load on a shared machine disturbs less than wall time.
+use super::render::cpu_seconds;
 use crate::data_args::CacheArg;
 use anyhow::Context;
 use deepbrdf_data::dataset::load_material;
@@ -91,8 +93,8 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         brdfs.push((name.clone(), Box::new(brdf), build));
     }
     println!(
-        "{:<34} {:<10} {:>9} {:>9} {:>11} {:>9}",
-        "material", "light", "s/image", "noise", "efficiency", "build s"
+        "{:<34} {:<10} {:>9} {:>9} {:>9} {:>11} {:>11} {:>9}",
+        "material", "light", "s/image", "cpu s", "noise", "efficiency", "eff. (cpu)", "build s"
     );
     for light in &args.lights {
         let spec: LightSpec = light.parse().with_context(|| format!("parsing light '{light}'"))?;
@@ -100,6 +102,7 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         for (name, brdf, build) in &brdfs {
             let mut images = Vec::new();
             let mut seconds = 0.0;
+            let cpu_start = cpu_seconds();
             for seed in [1, 2] {
                 let settings =
                     RenderSettings { size: args.size, spp: args.spp, seed, jitter: true };
@@ -107,11 +110,15 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
                 images.push(render(&scene, brdf.as_ref(), &settings, &Silent)?);
                 seconds += start.elapsed().as_secs_f64() / 2.0;
             }
+            let cpu = cpu_start.zip(cpu_seconds()).map(|(a, b)| (b - a) / 2.0);
             let noise = relative_noise(&images[0], &images[1])
                 .with_context(|| format!("{name} under {light}: no covered, lit pixels"))?;
+            let efficiency = |s: f64| format!("{:.1}", 1.0 / (noise * noise * s));
             println!(
-                "{name:<34} {light:<10} {seconds:>9.3} {noise:>9.4} {:>11.1} {build:>9.3}",
-                1.0 / (noise * noise * seconds)
+                "{name:<34} {light:<10} {seconds:>9.3} {:>9} {noise:>9.4} {:>11} {:>11} {build:>9.3}",
+                cpu.map_or("n/a".into(), |c| format!("{c:.2}")),
+                efficiency(seconds),
+                cpu.map_or("n/a".into(), efficiency),
             );
         }
     }
