@@ -1,9 +1,28 @@
 //! `experiments baselines` end to end on a small folder of MERL files.
 use crate::util;
 use deepbrdf_data::merl::grid::theta_h_of;
-use deepbrdf_data::merl::io::write_merl;
-use deepbrdf_data::MerlTable;
+use deepbrdf_data::merl::io::{read_merl, write_merl};
+use deepbrdf_data::{MerlTable, Silent};
+use deepbrdf_eval::baseline::BaselineMethod;
+use deepbrdf_eval::harness::{self, HarnessConfig, Materials, Measure, Method, Mode};
+use std::collections::BTreeMap;
 use std::path::Path;
+
+/// `results.csv` as `(method, k, material, measure) -> value`, checking its header and fields.
+fn read_results(path: &Path) -> BTreeMap<(String, usize, String, String), f64> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("method,k,fold,material,measure,value"));
+    let mut rows = BTreeMap::new();
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        assert_eq!(f.len(), 6, "{line}");
+        let key = (f[0].to_string(), f[1].parse().unwrap(), f[3].to_string(), f[4].to_string());
+        assert_eq!(f[2], "0", "in-sample has one fold: {line}");
+        assert!(rows.insert(key, f[5].parse::<f64>().unwrap()).is_none(), "repeated row {line}");
+    }
+    rows
+}
 
 /// Writes `n` MERL files (a diffuse colour plus a theta_h lobe, varied per material) into `dir`.
 fn write_materials(dir: &Path, n: usize) {
@@ -50,6 +69,49 @@ fn baselines_in_sample_writes_results_and_bases_and_protects_them() {
     for f in ["PCA.basis", "IPCA.basis"] {
         assert!(dir.path().join("bases").join(f).is_file(), "{f} missing");
     }
+    // The CSV holds exactly what the library's harness computes on the same files, and the
+    // error falls with k for both methods and both measures.
+    let rows = read_results(&dir.path().join("res/results.csv"));
+    assert_eq!(rows.len(), 2 * 2 * 4 * 2, "methods x k x materials x measures");
+    let names: Vec<String> = (0..4).map(|i| format!("material-{i}")).collect();
+    let tables: Vec<MerlTable> = names
+        .iter()
+        .map(|n| read_merl(Path::new(data).join(format!("{n}.binary"))).unwrap())
+        .collect();
+    let config = HarnessConfig {
+        ks: vec![1, 3],
+        mode: Mode::InSample,
+        seed: 0,
+        measures: vec![Measure::MappedMse, Measure::CosRmse],
+    };
+    let (pca, ipca) = (BaselineMethod::pca(), BaselineMethod::ipca());
+    let methods: [&dyn Method; 2] = [&pca, &ipca];
+    let label = "direct";
+    let direct = harness::run(
+        &methods,
+        &config,
+        Materials { names: &names, tables: &tables, label },
+        None,
+        &Silent,
+    )
+    .unwrap();
+    assert_eq!(direct.records.len(), rows.len());
+    for r in &direct.records {
+        let key = (r.method.clone(), r.k, r.material.clone(), r.measure.name().to_string());
+        assert_eq!(rows.get(&key), Some(&r.value), "{key:?}");
+    }
+    for method in ["PCA", "IPCA"] {
+        for measure in ["mapped_mse", "cos_rmse"] {
+            let mean = |k: usize| {
+                names
+                    .iter()
+                    .map(|n| rows[&(method.into(), k, n.clone(), measure.into())])
+                    .sum::<f64>()
+                    / 4.0
+            };
+            assert!(mean(3) < 1e-3 * mean(1), "{method} {measure}: {} -> {}", mean(1), mean(3));
+        }
+    }
     // A second run into the same folders refuses before doing any work ...
     std::fs::write(dir.path().join("res/notes.txt"), "mine").unwrap();
     let again = util::run_in(dir.path(), &args);
@@ -82,4 +144,20 @@ fn baselines_rejects_bad_arguments_cleanly() {
     }
     let missing = util::run_in(dir.path(), &["baselines", "--data", "no-such-dir"]);
     util::assert_clean_failure(&missing, "no-such-dir");
+}
+
+#[test]
+fn baselines_write_the_same_bytes_with_one_thread_and_with_several() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("data");
+    write_materials(&data, 5);
+    let data = data.to_str().unwrap();
+    let mut csv = Vec::new();
+    for (threads, out) in [(1, "one"), (3, "three")] {
+        let args = ["baselines", "--data", data, "--k", "1,2", "--out", out];
+        let output = util::run_on_threads(dir.path(), &args, threads);
+        assert!(output.status.success(), "{}", util::stderr(&output));
+        csv.push(std::fs::read(dir.path().join(out).join("results.csv")).unwrap());
+    }
+    assert!(csv[0] == csv[1], "results.csv differs between 1 and 3 threads");
 }

@@ -7,5 +7,6 @@ mod data;
 mod devices;
 mod fetch_merl;
 mod model;
+mod reliability;
 mod render;
 mod sweep_k;

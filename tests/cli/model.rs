@@ -3,7 +3,7 @@
 //! model directory holds the compact basis, the commands chain, a reconstruction of a training
 //! material comes back close, and bad inputs are named.
 use crate::util;
-use deepbrdf_data::merl::{read_merl, write_merl};
+use deepbrdf_data::merl::read_merl;
 use deepbrdf_model::burn::config::Config as _;
 use deepbrdf_model::{AutoencoderConfig, TrainConfig};
 use std::path::Path;
@@ -15,11 +15,7 @@ fn s(p: &Path) -> String {
 #[test]
 fn train_encode_decode_and_reconstruct_a_spectral_model() {
     let dir = tempfile::tempdir().unwrap();
-    let data = dir.path().join("data");
-    std::fs::create_dir(&data).unwrap();
-    for i in 0..3 {
-        write_merl(&util::material(i), data.join(format!("m{i}.binary"))).unwrap();
-    }
+    let data = util::write_data(dir.path(), 3);
     let mut config = TrainConfig::cpu(2).with_epochs(3).with_batch_size(2);
     config.model = AutoencoderConfig::spectral(2, 3, Some(8));
     let config_path = dir.path().join("tiny.json");
@@ -37,10 +33,10 @@ fn train_encode_decode_and_reconstruct_a_spectral_model() {
     let latent = dir.path().join("m1.json");
     ok(&["encode", &s(&run), &m1, "-o", &s(&latent)]);
     assert!(std::fs::read_to_string(&latent).unwrap().contains(','), "two latent values");
-    let decoded = dir.path().join("m1-decoded.binary");
-    ok(&["decode", &s(&run), &s(&latent), "-o", &s(&decoded)]);
+    let decoded_path = dir.path().join("m1-decoded.binary");
+    ok(&["decode", &s(&run), &s(&latent), "-o", &s(&decoded_path)]);
     let original = util::material(1);
-    let decoded = read_merl(&decoded).unwrap();
+    let decoded = read_merl(&decoded_path).unwrap();
     assert_eq!(decoded.mask(), original.mask());
     // Three materials span two directions around their mean: k = 2 holds a training material
     // up to f16 rounding and three epochs of the MLPs (which start at zero).
@@ -59,6 +55,33 @@ fn train_encode_decode_and_reconstruct_a_spectral_model() {
     ok(&["reconstruct", &s(&run), &m1, "-o", &s(&reconstructed), "--slices", "1/9"]);
     assert_eq!(read_merl(&reconstructed).unwrap().mask(), original.mask());
 
+    // A latent vector made by another model is refused, naming both, unless --force; one of
+    // the wrong length is refused even then.
+    let text = std::fs::read_to_string(&latent).unwrap();
+    let value: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let own_id = value["model_id"].as_str().unwrap().to_string();
+    let foreign = dir.path().join("foreign.json");
+    std::fs::write(&foreign, text.replace(&own_id, "0123456789abcdef")).unwrap();
+    let out = util::run_in(dir.path(), &["decode", &s(&run), &s(&foreign), "-o", "foreign.binary"]);
+    util::assert_clean_failure(&out, "made by model 0123456789abcdef");
+    util::assert_clean_failure(&out, &own_id);
+    assert!(!dir.path().join("foreign.binary").exists(), "nothing written on refusal");
+    ok(&["decode", &s(&run), &s(&foreign), "-o", "foreign.binary", "--force"]);
+    assert_eq!(
+        read_merl(dir.path().join("foreign.binary")).unwrap(),
+        read_merl(&decoded_path).unwrap()
+    );
+    let mut long = value.clone();
+    long["latent"] = serde_json::json!([0.1, 0.2, 0.3]);
+    long["k"] = serde_json::json!(3);
+    let long_path = dir.path().join("long.json");
+    std::fs::write(&long_path, long.to_string()).unwrap();
+    let out = util::run_in(
+        dir.path(),
+        &["decode", &s(&run), &s(&long_path), "-o", "long.binary", "--force"],
+    );
+    util::assert_clean_failure(&out, "k = 2");
+
     let missing = s(&dir.path().join("missing.json"));
     let out = util::run_in(dir.path(), &["decode", &s(&run), &missing, "-o", "x.binary"]);
     util::assert_clean_failure(&out, "missing.json");
@@ -68,4 +91,39 @@ fn train_encode_decode_and_reconstruct_a_spectral_model() {
     std::fs::write(&basis, bytes).unwrap();
     let out = util::run_in(dir.path(), &["encode", &s(&run), &m1]);
     util::assert_clean_failure(&out, "basis.f16");
+}
+
+#[test]
+fn train_names_a_bad_config_file_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = util::write_data(dir.path(), 1);
+    let saved = dir.path().join("saved.json");
+    TrainConfig::cpu(2).save(&saved).unwrap();
+    let mut good: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&saved).unwrap()).unwrap();
+    assert!(good.get("epochs").is_some(), "{good}");
+    good["epochs"] = serde_json::json!("many");
+    let cases = [
+        ("broken.json", "{ \"epochs\": 3,".to_string(), "broken.json"),
+        ("wrong-type.json", good.to_string(), "wrong-type.json"),
+        ("empty.json", String::new(), "empty.json"),
+    ];
+    for (name, text, needle) in cases {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        let run = dir.path().join(format!("run-{name}"));
+        let out = util::run_in(
+            dir.path(),
+            &["train", "--config", &s(&path), "--data", &s(&data), "--out", &s(&run)],
+        );
+        util::assert_clean_failure(&out, needle);
+        util::assert_clean_failure(&out, "not a training configuration");
+        assert!(!run.exists(), "{name}: a run folder was created");
+    }
+    let missing = dir.path().join("missing.json");
+    let out = util::run_in(
+        dir.path(),
+        &["train", "--config", &s(&missing), "--data", &s(&data), "--out", "run"],
+    );
+    util::assert_clean_failure(&out, "missing.json");
 }

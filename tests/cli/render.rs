@@ -166,3 +166,32 @@ fn bench_render_prints_its_numbers() {
         assert!(text.contains(needle), "{needle}: {text}");
     }
 }
+
+#[test]
+fn bench_render_noise_prints_noise_and_efficiency() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    write_material(&dir.path().join("m.binary"), [0.5; 3], 1.0);
+    let out = util::run_in(
+        dir.path(),
+        &[
+            "bench",
+            "render-noise",
+            "--materials",
+            "m.binary",
+            "--lights",
+            "const;sun:40,30",
+            "--size",
+            "16",
+            "--spp",
+            "2",
+        ],
+    );
+    assert!(out.status.success(), "{}", util::stderr(&out));
+    let text = util::stdout(&out);
+    assert!(text.contains("efficiency"), "{text}");
+    // One row per material and light: Lambertian, plastic and the table, under both lights.
+    let rows: Vec<&str> =
+        text.lines().filter(|l| l.contains("const") || l.contains("sun:")).collect();
+    assert_eq!(rows.iter().filter(|l| l.starts_with("m ")).count(), 2, "{text}");
+    assert_eq!(rows.len(), 6, "{text}");
+}

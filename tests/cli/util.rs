@@ -15,6 +15,29 @@ pub fn run_in(cwd: &Path, args: &[&str]) -> Output {
         .expect("failed to spawn the experiments binary")
 }
 
+/// Runs `experiments` with `args` in `cwd` (quiet) on `threads` rayon threads.
+pub fn run_on_threads(cwd: &Path, args: &[&str], threads: usize) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_experiments"))
+        .args(args)
+        .arg("--quiet")
+        .env("RAYON_NUM_THREADS", threads.to_string())
+        .current_dir(cwd)
+        .output()
+        .expect("failed to spawn the experiments binary")
+}
+
+/// Writes materials `0..n` ([`material`]) as `m{i}.binary` into a new folder `dir/data`, and
+/// returns that folder.
+pub fn write_data(dir: &Path, n: usize) -> std::path::PathBuf {
+    let data = dir.join("data");
+    std::fs::create_dir(&data).expect("creating the data folder");
+    for i in 0..n {
+        deepbrdf_data::merl::write_merl(&material(i), data.join(format!("m{i}.binary")))
+            .expect("writing a material");
+    }
+    data
+}
+
 /// Runs `experiments` with `args` in a fresh temporary directory.
 pub fn run(args: &[&str]) -> Output {
     let dir = tempfile::tempdir().expect("tempdir");

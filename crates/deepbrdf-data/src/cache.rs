@@ -13,12 +13,12 @@
 //! u32, key (32 bytes), SHA-256 of the values (32 bytes), then [`VALUES`] f32.
 
 use crate::error::{DataError, Result};
+use crate::files::create_parent_and_write;
 use crate::merl::{MerlTable, VALUES};
 use crate::nbrdf::{tabulate, Network, TABULATOR_VERSION};
 use crate::rgl::{RglBrdf, RGL_TABULATOR_VERSION};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Environment variable that overrides the default cache directory.
 pub const CACHE_ENV: &str = "DEEPBRDF_CACHE";
@@ -212,7 +212,7 @@ fn store(path: &Path, key: &[u8; 32], version: u32, table: &MerlTable) -> Result
     bytes.extend(table.values().iter().flat_map(|v| v.to_le_bytes()));
     let digest = Sha256::digest(&bytes[HEADER..]);
     bytes[48..80].copy_from_slice(&digest);
-    write_atomically(path, &bytes)
+    create_parent_and_write(path, &bytes)
 }
 
 /// Removes other cache files of the same material (older keys).
@@ -231,31 +231,6 @@ fn prune_stale(current: &Path, name: &str) {
             let _ = std::fs::remove_file(entry.path());
         }
     }
-}
-
-/// Writes `bytes` to `path` without ever leaving a partial file under that name: write a
-/// uniquely named temporary file in the same directory, then rename it over `path`.
-/// Creates the parent directory if needed.
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    std::fs::create_dir_all(&dir).map_err(|e| DataError::io(&dir, e))?;
-    let file_name = path.file_name().and_then(|n| n.to_str()).unwrap_or("file");
-    let tmp = dir.join(format!(
-        ".{file_name}.{}-{}.tmp",
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    let result = std::fs::write(&tmp, bytes)
-        .map_err(|e| DataError::io(&tmp, e))
-        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| DataError::io(path, e)));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
 }
 
 #[cfg(test)]

@@ -42,6 +42,23 @@ pub(crate) fn read_exactly(file: &mut File, path: &Path, len: usize) -> Result<V
 /// flushed to disk and renamed over `path`. On failure `path` is untouched and the temporary file
 /// is removed.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_atomic_parts(path, &[bytes])
+}
+
+/// Creates the parent directory of `path` if needed, then writes `bytes` there atomically
+/// ([`write_atomic`]).
+pub fn create_parent_and_write(path: &Path, bytes: &[u8]) -> Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| DataError::io(dir, e))?;
+    }
+    write_atomic(path, bytes)
+}
+
+/// Writes `parts`, concatenated, to `path` atomically (the one atomic writer of the workspace):
+/// a uniquely named temporary file in the same directory (two runs writing the same path never
+/// share it) is written, flushed to disk (fsync) and renamed over `path`, then the directory entry
+/// is flushed. On failure `path` is untouched and the temporary file is removed.
+pub fn write_atomic_parts(path: &Path, parts: &[&[u8]]) -> Result<()> {
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -54,10 +71,24 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         .suffix(".tmp")
         .tempfile_in(dir)
         .map_err(|e| DataError::io(dir, e))?;
-    tmp.write_all(bytes).map_err(|e| DataError::io(tmp.path(), e))?;
+    for part in parts {
+        tmp.write_all(part).map_err(|e| DataError::io(tmp.path(), e))?;
+    }
     tmp.as_file().sync_all().map_err(|e| DataError::io(tmp.path(), e))?;
     tmp.persist(path).map_err(|e| DataError::io(path, e.error))?;
+    sync_dir_of(path);
     Ok(())
+}
+
+/// Flushes the directory entry of `path` to disk after a rename (best effort: not every platform
+/// allows opening a directory).
+pub fn sync_dir_of(path: &Path) {
+    if let Some(parent) = path.parent() {
+        let dir = if parent.as_os_str().is_empty() { Path::new(".") } else { parent };
+        if let Ok(d) = File::open(dir) {
+            let _ = d.sync_all();
+        }
+    }
 }
 
 #[cfg(test)]
@@ -71,7 +102,7 @@ mod tests {
         let dir = tempfile::tempdir()?;
         let path = dir.path().join("a.bin");
         write_atomic(&path, b"first")?;
-        write_atomic(&path, b"second")?;
+        write_atomic_parts(&path, &[b"sec", b"", b"ond"])?;
         assert_eq!(std::fs::read(&path)?, b"second");
         let names: Vec<_> =
             std::fs::read_dir(dir.path())?.filter_map(|e| e.ok()).map(|e| e.file_name()).collect();

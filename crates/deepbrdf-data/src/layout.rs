@@ -18,8 +18,10 @@ pub const SIDE: usize = N_THETA_H;
 pub const PLANE: usize = SIDE * SIDE;
 /// Values per phi_d slice (its 3 colour channels).
 pub const SLICE_VALUES: usize = 3 * PLANE;
+/// Values of the whole layout, 540 x 90 x 90 = [`VALUES`] (the autoencoder's input size).
+pub const LAYOUT_VALUES: usize = SLICE_CHANNELS * PLANE;
 
-const _: () = assert!(N_THETA_H == N_THETA_D && SLICE_CHANNELS * PLANE == VALUES);
+const _: () = assert!(N_THETA_H == N_THETA_D && LAYOUT_VALUES == VALUES);
 
 /// Index in the layout of colour `rgb` at cell (theta_h, theta_d, phi_d).
 #[inline]

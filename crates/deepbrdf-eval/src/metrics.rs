@@ -143,13 +143,13 @@ impl Default for ImageRelaeConfig {
 }
 
 /// Image-space RelAE of reconstructions of one original table: the original is rendered once;
-/// each reconstruction is rendered with the same seed and the original's sampling proxy, so both
+/// each reconstruction is rendered with the same seed and the original's sampling, so both
 /// renders draw the same directions and their difference carries (almost) no Monte Carlo noise,
 /// only the difference of the BRDFs.
 pub struct ImageRelae {
     scene: Scene,
     config: ImageRelaeConfig,
-    lobe: deepbrdf_render::SamplingLobe,
+    sampling: deepbrdf_render::MerlSampling,
     reference: Image,
 }
 
@@ -159,7 +159,7 @@ impl ImageRelae {
         let scene = config.scene.build()?;
         let brdf = MerlBrdf::new(original);
         let reference = render(&scene, &brdf, &config.render, &Silent)?;
-        Ok(Self { scene, config: *config, lobe: brdf.lobe(), reference })
+        Ok(Self { scene, config: *config, sampling: brdf.sampling().clone(), reference })
     }
 
     /// The original's render.
@@ -169,7 +169,7 @@ impl ImageRelae {
 
     /// Renders `reconstruction` like the original.
     pub fn render(&self, reconstruction: &MerlTable) -> Result<Image> {
-        let brdf = MerlBrdf::new(reconstruction).with_lobe(self.lobe);
+        let brdf = MerlBrdf::new_sampled(reconstruction, self.sampling.clone());
         Ok(render(&self.scene, &brdf, &self.config.render, &Silent)?)
     }
 

@@ -2,29 +2,24 @@
 //! `A - mu = U Sigma V^T`, truncated to the first k terms, with one BRDF per row of `A`.
 //!
 //! [`LinearBasis`] is the linear algebra on plain rows of any length (so it can be tested on
-//! small synthetic data); [`Pca`] is the paper's "traditional PCA" on MERL tables: the natural
+//! small synthetic data); the paper's "traditional PCA" on MERL tables: the natural
 //! logarithm of the reflectance ([`LOG_EPSILON`] added), all three channels in one row, over the
-//! valid cells (see [`crate::baseline::Domain`]).
+//! valid cells, is this basis fitted by the baselines' `BaselineMethod::pca`.
 //!
-//! The fit never forms the `d x d` covariance (d = 4,374,000 for a MERL table). With n rows,
-//! the `n x n` Gram matrix `G = (A - mu)(A - mu)^T` is accumulated in f64 over column blocks
-//! (in parallel), its eigenpairs `G u_j = lambda_j u_j` give the singular values
-//! `sigma_j = sqrt(lambda_j)` and the principal directions `v_j = (A - mu)^T u_j / sigma_j`
-//! (the columns of V in eq. 5). Components are stored as f32.
+//! The fit never forms the `d x d` covariance (d = 4,374,000 for a MERL table): it takes the
+//! Gram route of [`deepbrdf_data::gram_pca`] (the `n x n` Gram matrix in f64 over column blocks
+//! added in a fixed order, its eigenpairs giving `sigma_j` and the principal directions
+//! `v_j = (A - mu)^T u_j / sigma_j`, the columns of V in eq. 5). Components are stored as f32.
+//! Every sum has a fixed order, so a fit and an encoding are the same bits for any thread count.
 
-use crate::baseline::{BaselineMethod, Mapping};
 use crate::error::{EvalError, Result};
+use deepbrdf_data::gram_pca::{leading_eigenpairs, ordered_block_sum};
 use deepbrdf_data::Progress;
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 
 /// Columns per block of the Gram and projection passes (a block of 100 rows is 3.2 MB in f64).
 const BLOCK: usize = 4096;
-
-/// Eigenvalues of the Gram matrix below this fraction of the largest are treated as zero: their
-/// directions are numerical noise (data of rank r < n leaves n - r of them at round-off level),
-/// so the corresponding components are set to zero instead of amplifying noise by `1/sigma`.
-pub const RELATIVE_EIGEN_FLOOR: f64 = 1e-10;
 
 /// The epsilon of traditional PCA's logarithm: rows hold `ln(rho + LOG_EPSILON)`. The paper only
 /// says "the natural logarithm"; MERL tables contain zeros, so a small offset is needed, and we
@@ -93,45 +88,26 @@ impl LinearBasis {
             }
         });
 
-        // G = sum over blocks of Xb^T Xb, Xb the centred block (block columns x n, column-major).
-        let gram = (0..blocks)
-            .into_par_iter()
-            .fold(
-                || DMatrix::<f64>::zeros(n, n),
-                |mut g, b| {
-                    let xb = centred_block(rows, &mean, b);
-                    let xbt = xb.transpose();
-                    g.gemm(1.0, &xbt, &xb, 1.0);
-                    progress.advance(1);
-                    g
-                },
-            )
-            .reduce(|| DMatrix::<f64>::zeros(n, n), |a, b| a + b);
-        let gram = (&gram + gram.transpose()) * 0.5;
-
-        let eig = nalgebra::SymmetricEigen::try_new(gram, 1e-14, 10_000).ok_or_else(|| {
-            EvalError::Invalid("the Gram matrix eigendecomposition did not converge".into())
-        })?;
-        let mut order: Vec<usize> = (0..n).collect();
-        order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
-        let largest = eig.eigenvalues[order[0]].max(0.0);
-        let floor = largest * RELATIVE_EIGEN_FLOOR;
+        // G = sum over blocks of Xb^T Xb, Xb the centred block (block columns x n,
+        // column-major), added in block order (the same bits for any thread count).
+        let gram = ordered_block_sum(blocks, n, |b| {
+            let xb = centred_block(rows, &mean, b);
+            let g = xb.transpose() * &xb;
+            progress.advance(1);
+            g
+        });
+        let pairs = leading_eigenpairs(gram, k)?;
 
         // W = U_k diag(1/sigma) (n x k); a zero column for eigenvalues at the noise floor.
-        let mut singular_values = Vec::with_capacity(k);
         let mut w = DMatrix::<f64>::zeros(n, k);
-        for (j, &e) in order.iter().take(k).enumerate() {
-            let lambda = eig.eigenvalues[e];
-            if lambda > floor && lambda > 0.0 {
-                let sigma = lambda.sqrt();
-                singular_values.push(sigma);
+        for (j, &sigma) in pairs.sigmas.iter().enumerate() {
+            if sigma > 0.0 {
                 for i in 0..n {
-                    w[(i, j)] = eig.eigenvectors[(i, e)] / sigma;
+                    w[(i, j)] = pairs.vectors[(i, j)] / sigma;
                 }
-            } else {
-                singular_values.push(0.0);
             }
         }
+        let singular_values = pairs.sigmas;
 
         // V = (A - mu)^T W, block by block: Vb = Xb W (block columns x k).
         let mut components = vec![0f32; dim * k];
@@ -205,31 +181,28 @@ impl LinearBasis {
         }
         self.check_k(k)?;
         let kk = self.k;
-        let sums = row
+        // Per-block partial sums in parallel, added in block order (thread-count independent).
+        let parts: Vec<Vec<f64>> = row
             .par_chunks(BLOCK)
             .enumerate()
-            .fold(
-                || vec![0f64; k],
-                |mut acc, (b, chunk)| {
-                    let start = b * BLOCK;
-                    for (c, &x) in chunk.iter().enumerate() {
-                        let d = start + c;
-                        let centred = f64::from(x) - f64::from(self.mean[d]);
-                        let v = &self.components[d * kk..d * kk + k];
-                        for (a, &vj) in acc.iter_mut().zip(v) {
-                            *a += centred * f64::from(vj);
-                        }
+            .map(|(b, chunk)| {
+                let start = b * BLOCK;
+                let mut acc = vec![0f64; k];
+                for (c, &x) in chunk.iter().enumerate() {
+                    let d = start + c;
+                    let centred = f64::from(x) - f64::from(self.mean[d]);
+                    let v = &self.components[d * kk..d * kk + k];
+                    for (a, &vj) in acc.iter_mut().zip(v) {
+                        *a += centred * f64::from(vj);
                     }
-                    acc
-                },
-            )
-            .reduce(
-                || vec![0f64; k],
-                |mut a, b| {
-                    a.iter_mut().zip(&b).for_each(|(x, y)| *x += y);
-                    a
-                },
-            );
+                }
+                acc
+            })
+            .collect();
+        let mut sums = vec![0f64; k];
+        for part in &parts {
+            sums.iter_mut().zip(part).for_each(|(x, y)| *x += y);
+        }
         Ok(sums.into_iter().map(|s| s as f32).collect())
     }
 
@@ -277,18 +250,6 @@ fn centred_block(rows: &[&[f32]], mean: &[f32], b: usize) -> DMatrix<f64> {
         );
     }
     DMatrix::from_vec(cols, rows.len(), data)
-}
-
-/// The paper's "traditional PCA" (§4): natural log of the reflectance, all three channels of a
-/// BRDF in one row, mean-centred, truncated to k components.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Pca;
-
-impl Pca {
-    /// The method, as run by the harness.
-    pub fn method() -> BaselineMethod {
-        BaselineMethod::new("PCA", Mapping::log_kind())
-    }
 }
 
 #[cfg(test)]

@@ -25,11 +25,12 @@ use deepbrdf_data::mapping::MedianReference;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
-use crate::atomic::{read_limited, sync_parent, write_atomic};
-use crate::autoencoder::{Autoencoder, AutoencoderConfig};
+use crate::atomic::{read_limited, write_atomic};
+use crate::autoencoder::{legacy, Autoencoder, AutoencoderConfig};
 use crate::compact::CompactBasis;
 use crate::error::{ModelError, Result};
 use crate::train::Trained;
+use deepbrdf_data::files::sync_dir_of;
 
 /// File name of the manifest.
 pub const MANIFEST_FILE: &str = "model.json";
@@ -102,7 +103,9 @@ struct Manifest {
     format: String,
     version: u32,
     id: String,
-    config: AutoencoderConfig,
+    /// The network's configuration as it was written (and hashed into the id): the current
+    /// format or the flat one of earlier versions.
+    config: serde_json::Value,
     provenance: Provenance,
     weights: Part,
     reference: Part,
@@ -122,6 +125,8 @@ struct Parts {
 #[derive(Debug, Clone)]
 pub struct ModelArtifact {
     config: AutoencoderConfig,
+    /// `config` in the form the manifest holds and the id covers (see [`Manifest::config`]).
+    config_json: serde_json::Value,
     provenance: Provenance,
     weights: Vec<u8>,
     /// A spectral-only network's basis, serialised compact ([`CompactBasis::to_bytes`]).
@@ -187,7 +192,7 @@ impl ModelArtifact {
     ) -> Result<Self> {
         let mut model = model.clone();
         let basis = match compact && config.spectral_only() {
-            true => Some(model.take_compact_basis()?.to_bytes()),
+            true => Some(CompactBasis::take_from(&mut model)?.to_bytes()),
             false => None,
         };
         let weights = model
@@ -195,13 +200,18 @@ impl ModelArtifact {
             .into_bytes()
             .map_err(|e| ModelError::Invalid(format!("cannot serialise the weights: {e}")))?
             .to_vec();
+        // Without Burn's random parameter ids, the same network has the same bytes.
+        let weights = crate::record::rewrite(weights, false, |name| name)
+            .map_err(|e| ModelError::Invalid(format!("cannot serialise the weights: {e}")))?;
         let parts = Parts {
             weights: part_of(&weights, WEIGHTS_FILE),
             reference: reference_part(&reference),
             basis: basis.as_ref().map(|b| part_of(b, BASIS_FILE)),
         };
-        let id = manifest_id(&config, &provenance, &parts);
-        Ok(Self { config, provenance, weights, basis, reference, parts, id })
+        let config_json = serde_json::to_value(&config)
+            .map_err(|e| ModelError::Invalid(format!("cannot serialise the configuration: {e}")))?;
+        let id = manifest_id(&config_json, &provenance, &parts);
+        Ok(Self { config, config_json, provenance, weights, basis, reference, parts, id })
     }
 
     /// The id tying configuration, provenance, weights and reference together.
@@ -232,7 +242,7 @@ impl ModelArtifact {
                 "this model's spectral basis is stored compact (f16); load it with DeepBrdf".into(),
             ));
         }
-        load_weights(self.config.init(device)?, self.weights.clone())
+        self.load_weights(self.config.init(device)?, self.weights.clone())
     }
 
     /// The network and, for a spectral-only one saved with it, its compact basis (the network
@@ -242,18 +252,30 @@ impl ModelArtifact {
     pub fn take_model(&mut self, device: &Device) -> Result<(Autoencoder, Option<CompactBasis>)> {
         let weights = std::mem::take(&mut self.weights);
         let Some(bytes) = self.basis.take() else {
-            return Ok((load_weights(self.config.init(device)?, weights)?, None));
+            return Ok((self.load_weights(self.config.init(device)?, weights)?, None));
         };
         let basis = CompactBasis::from_bytes(&bytes)
             .map_err(|e| ModelError::Invalid(format!("{BASIS_FILE}: {e}")))?;
-        if Some(basis.size()) != self.config.spectral_basis {
+        let directions = self.config.spectral_config().map(|s| s.directions);
+        if Some(basis.size()) != directions {
             return Err(ModelError::Invalid(format!(
-                "{BASIS_FILE} has {} directions, the configuration {:?}",
+                "{BASIS_FILE} has {} directions, the configuration {directions:?}",
                 basis.size(),
-                self.config.spectral_basis
             )));
         }
-        Ok((load_weights(self.config.init_without_basis(device)?, weights)?, Some(basis)))
+        Ok((self.load_weights(self.config.init_without_basis(device)?, weights)?, Some(basis)))
+    }
+
+    /// Loads burnpack `weights` into `network`; weights of a model saved before the
+    /// architectures became enum variants get their parameter paths upgraded first.
+    fn load_weights(&self, network: Autoencoder, weights: Vec<u8>) -> Result<Autoencoder> {
+        let weights = match legacy::is_legacy(&self.config_json) {
+            true => legacy::upgrade_record(weights, &self.config).map_err(|e| {
+                ModelError::Invalid(format!("{WEIGHTS_FILE} of model {}: {e}", self.id))
+            })?,
+            false => weights,
+        };
+        load_weights(network, weights)
     }
 
     /// Writes the artifact directory `dir` (created beside it, then renamed into place).
@@ -291,7 +313,7 @@ impl ModelArtifact {
             format: FORMAT.into(),
             version: VERSION,
             id: self.id.clone(),
-            config: self.config.clone(),
+            config: self.config_json.clone(),
             provenance: self.provenance.clone(),
             weights: self.parts.weights.clone(),
             reference: self.parts.reference.clone(),
@@ -320,7 +342,10 @@ impl ModelArtifact {
                 ),
             ));
         }
-        manifest.config.validate()?;
+        let config = AutoencoderConfig::try_from(manifest.config.clone()).map_err(|e| {
+            ModelError::format(&manifest_path, format!("bad network configuration: {e}"))
+        })?;
+        config.validate()?;
         let weights_path = dir.join(WEIGHTS_FILE);
         let weights = read_limited(&weights_path, 4 << 30)?;
         if part_of(&weights, WEIGHTS_FILE) != manifest.weights {
@@ -369,7 +394,8 @@ impl ModelArtifact {
             ));
         }
         Ok(Self {
-            config: manifest.config,
+            config,
+            config_json: manifest.config,
             provenance: manifest.provenance,
             weights,
             basis,
@@ -396,7 +422,7 @@ fn reference_part(reference: &MedianReference) -> Part {
 
 /// The id over configuration, provenance and the parts' checksums. A version 1 model (no
 /// basis part) keeps its id: the basis enters only when present.
-fn manifest_id(config: &AutoencoderConfig, provenance: &Provenance, parts: &Parts) -> String {
+fn manifest_id(config: &serde_json::Value, provenance: &Provenance, parts: &Parts) -> String {
     let mut content = serde_json::json!({
         "config": config,
         "provenance": provenance,
@@ -475,7 +501,7 @@ fn replace_dir(tmp: &Path, dir: &Path) -> Result<()> {
     } else {
         fs::rename(tmp, dir).map_err(|e| ModelError::io(dir, e))?;
     }
-    sync_parent(dir);
+    sync_dir_of(dir);
     Ok(())
 }
 
@@ -486,13 +512,13 @@ mod tests {
     use deepbrdf_data::merl::VALUES;
 
     fn tiny() -> AutoencoderConfig {
-        AutoencoderConfig::new()
-            .with_latent(2)
+        let layers = crate::autoencoder::ConvolutionalConfig::new()
             .with_projection(Some(1))
             .with_encoder_channels([1, 1, 1])
             .with_residual_blocks(1)
             .with_decoder_channels([1, 1])
-            .with_mean_offset(true)
+            .with_mean_offset(true);
+        AutoencoderConfig::convolutional(2, layers)
     }
 
     fn provenance() -> Provenance {

@@ -1,48 +1,16 @@
-//! Crash-safe file writes: write a temporary file beside the target, flush it to disk, then
-//! rename it over the target, so a reader (or a run killed mid-write) sees the old file or the
-//! new one, never a mixture.
+//! Crash-safe file access of the model crate: atomic writes (through the data crate's one writer:
+//! a reader, or a run killed mid-write, sees the old file or the new one, never a mixture) and
+//! size-limited reads.
 
-use std::fs::{self, File};
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::fs;
+use std::path::Path;
 
 use crate::error::{ModelError, Result};
 
-/// The temporary name used while `path` is being written.
-pub fn temp_path(path: &Path) -> PathBuf {
-    let mut name = path.file_name().map(|n| n.to_os_string()).unwrap_or_default();
-    name.push(format!(".tmp{}", std::process::id()));
-    path.with_file_name(name)
-}
-
-/// Writes `parts` (concatenated) to `path` atomically.
+/// Writes `parts` (concatenated) to `path` atomically through the workspace's one writer,
+/// [`deepbrdf_data::files::write_atomic_parts`] (unique temporary name, fsync, rename).
 pub fn write_atomic(path: &Path, parts: &[&[u8]]) -> Result<()> {
-    let tmp = temp_path(path);
-    let result = (|| {
-        let mut file = File::create(&tmp).map_err(|e| ModelError::io(&tmp, e))?;
-        for part in parts {
-            file.write_all(part).map_err(|e| ModelError::io(&tmp, e))?;
-        }
-        file.sync_all().map_err(|e| ModelError::io(&tmp, e))?;
-        drop(file);
-        fs::rename(&tmp, path).map_err(|e| ModelError::io(path, e))?;
-        sync_parent(path);
-        Ok(())
-    })();
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
-    }
-    result
-}
-
-/// Flushes the directory entry of `path` (best effort: not every platform allows it).
-pub fn sync_parent(path: &Path) {
-    if let Some(parent) = path.parent() {
-        let dir = if parent.as_os_str().is_empty() { Path::new(".") } else { parent };
-        if let Ok(d) = File::open(dir) {
-            let _ = d.sync_all();
-        }
-    }
+    Ok(deepbrdf_data::files::write_atomic_parts(path, parts)?)
 }
 
 /// Reads a whole file, refusing ones larger than `limit` bytes (a foreign or damaged file must

@@ -6,10 +6,11 @@ use std::path::Path;
 use burn::prelude::*;
 use burn::tensor::TensorData;
 use deepbrdf_data::augment::fill_missing_layout;
-use deepbrdf_data::layout::{from_layout, mask_layout, to_layout};
+use deepbrdf_data::layout::from_layout;
 use deepbrdf_data::mapping::MedianReference;
-use deepbrdf_data::merl::grid::cell_is_valid;
-use deepbrdf_data::merl::{cell_coords, CELLS, N_PHI_D};
+use deepbrdf_data::merl::grid::valid_mask;
+use deepbrdf_data::merl::N_PHI_D;
+use deepbrdf_data::network_input::mapped_layout;
 use deepbrdf_data::MerlTable;
 
 use crate::artifact::{ModelArtifact, Provenance};
@@ -28,7 +29,7 @@ pub struct DeepBrdf {
     model: Autoencoder,
     basis: Option<CompactBasis>,
     artifact: ModelArtifact,
-    grid_mask: Vec<bool>,
+    grid_mask: &'static [bool],
     device: Device,
 }
 
@@ -46,10 +47,12 @@ impl DeepBrdf {
         let basis = match compact {
             Some(basis) => Some(basis),
             // A version 1 model: the f32 basis is in the network.
-            None if artifact.config().spectral_only() => Some(model.take_compact_basis()?),
+            None if artifact.config().spectral_config().is_some() => {
+                Some(CompactBasis::take_from(&mut model)?)
+            }
             None => None,
         };
-        Ok(Self { model, basis, artifact, grid_mask: grid_mask(), device })
+        Ok(Self { model, basis, artifact, grid_mask: valid_mask(), device })
     }
 
     /// k, the number of latent values.
@@ -79,8 +82,7 @@ impl DeepBrdf {
 
     /// Eq. (2): the k latent values of `table`.
     pub fn encode(&self, table: &MerlTable) -> Result<Vec<f32>> {
-        let input = to_layout(&self.reference().map(table));
-        let mask = mask_layout(&table.mask());
+        let (input, mask) = mapped_layout(table, self.reference());
         self.encode_layout(input, mask)
     }
 
@@ -92,9 +94,8 @@ impl DeepBrdf {
                 "kept slices must be a non-empty subset of 0..{N_PHI_D}"
             )));
         }
-        let mut input = to_layout(&self.reference().map(table));
+        let (mut input, mask) = mapped_layout(table, self.reference());
         fill_missing_layout(&mut input, kept);
-        let mask = mask_layout(&table.mask());
         for (v, m) in input.iter_mut().zip(&mask) {
             *v *= m;
         }
@@ -159,23 +160,13 @@ impl DeepBrdf {
     /// grid's valid cells; invalid cells negative as in MERL files).
     pub fn decode(&self, latent: &[f32]) -> Result<MerlTable> {
         let mapped = from_layout(&self.decode_layout(latent)?);
-        Ok(self.reference().unmap(&mapped, &self.grid_mask)?)
+        Ok(self.reference().unmap(&mapped, self.grid_mask)?)
     }
 
     /// Encode then decode.
     pub fn reconstruct(&self, table: &MerlTable) -> Result<MerlTable> {
         self.decode(&self.encode(table)?)
     }
-}
-
-/// The MERL grid's validity: a cell is valid when both directions are above the horizon.
-pub fn grid_mask() -> Vec<bool> {
-    (0..CELLS)
-        .map(|c| {
-            let (h, d, p) = cell_coords(c);
-            cell_is_valid(h, d, p)
-        })
-        .collect()
 }
 
 fn read_error(e: impl std::fmt::Debug) -> ModelError {
@@ -187,17 +178,18 @@ mod tests {
     use super::*;
     use crate::artifact::{Provenance, BASIS_FILE, WEIGHTS_FILE};
     use crate::device::DeviceKind;
-    use deepbrdf_data::merl::{read_merl, write_merl, VALUES};
+    use deepbrdf_data::layout::mask_layout;
+    use deepbrdf_data::merl::{read_merl, write_merl, CELLS, VALUES};
 
     fn codec() -> DeepBrdf {
         let device = DeviceKind::default_kind().unwrap().device().unwrap();
-        let config = AutoencoderConfig::new()
-            .with_latent(3)
+        let layers = crate::autoencoder::ConvolutionalConfig::new()
             .with_projection(Some(1))
             .with_encoder_channels([1, 1, 1])
             .with_residual_blocks(0)
             .with_decoder_channels([1, 1])
             .with_mean_offset(true);
+        let config = AutoencoderConfig::convolutional(3, layers);
         let offset: Vec<f32> = (0..INPUT_VALUES).map(|i| 0.5 + 0.1 * ((i % 11) as f32)).collect();
         let model = config.init_seeded(3, &device).unwrap().with_offset(&offset).unwrap();
         let provenance = Provenance::untrained("synthetic", 3);
@@ -214,7 +206,7 @@ mod tests {
     /// there, k = 2; with the offset.
     fn spectral_network(device: &Device) -> (AutoencoderConfig, Autoencoder, Vec<f32>) {
         let config = AutoencoderConfig::spectral(2, 3, Some(4));
-        let valid = mask_layout(&grid_mask());
+        let valid = mask_layout(valid_mask());
         let basis: Vec<f32> = (0..3 * INPUT_VALUES)
             .map(|i| valid[i % INPUT_VALUES] * (noise(1, i) - 0.5) * 1e-3)
             .collect();
@@ -271,7 +263,7 @@ mod tests {
         // The codec's compact f16 basis against the network's own f32 matmuls.
         let device = DeviceKind::default_kind().unwrap().device().unwrap();
         let (config, network, offset) = spectral_network(&device);
-        let valid = mask_layout(&grid_mask());
+        let valid = mask_layout(valid_mask());
         let provenance = Provenance::untrained("synthetic", 4);
         let reference = MedianReference::from_values(vec![0.2; VALUES]).unwrap();
         let artifact = ModelArtifact::new(config, provenance, &network, reference).unwrap();
@@ -303,7 +295,7 @@ mod tests {
     fn decoding_gives_a_valid_merl_table_that_survives_a_file() {
         let codec = codec();
         let table = codec.decode(&[0.1, -0.2, 0.3]).unwrap();
-        let mask = grid_mask();
+        let mask = valid_mask().to_vec();
         for (cell, &valid) in mask.iter().enumerate() {
             let rgb = [0, 1, 2].map(|c| table.values()[c * CELLS + cell]);
             if valid {
@@ -337,6 +329,6 @@ mod tests {
         assert_ne!(partial, full);
         assert!(codec.encode_partial(&table, &[]).is_err());
         assert!(codec.encode_partial(&table, &[180]).is_err());
-        assert_eq!(codec.reconstruct(&table).unwrap().mask(), grid_mask());
+        assert_eq!(codec.reconstruct(&table).unwrap().mask(), valid_mask());
     }
 }

@@ -13,7 +13,7 @@ use half::f16;
 use half::slice::HalfFloatSliceExt;
 use rayon::prelude::*;
 
-use crate::autoencoder::INPUT_VALUES;
+use crate::autoencoder::{Autoencoder, INPUT_VALUES};
 use crate::error::{ModelError, Result};
 
 /// Values (support cells) per parallel chunk; a fixed size, so sums run in a fixed order.
@@ -47,6 +47,21 @@ pub struct CompactBasis {
 }
 
 impl CompactBasis {
+    /// Moves the spectral basis out of `model` ([`crate::spectral::SpectralPath::take_basis`])
+    /// as a compact basis around the model's offset; the network can then no longer encode or
+    /// decode by itself, only run its coordinate-space MLPs.
+    pub(crate) fn take_from(model: &mut Autoencoder) -> Result<Self> {
+        let offset = model
+            .offset()
+            .ok_or_else(|| ModelError::Invalid("a network without an offset".into()))?;
+        let path = model
+            .spectral_mut()
+            .ok_or_else(|| ModelError::Invalid("this network has no spectral path".into()))?;
+        let size = path.size();
+        let rows = path.take_basis()?;
+        Self::new(&rows, size, &offset)
+    }
+
     /// From `size` rows of [`INPUT_VALUES`] values (row-major, as
     /// [`crate::principal::fit_basis`] gives them) and the offset they are centred on.
     pub fn new(rows: &[f32], size: usize, offset: &[f32]) -> Result<Self> {

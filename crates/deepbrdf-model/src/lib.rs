@@ -1,7 +1,10 @@
 //! `deepbrdf-model`: the DeepBRDF networks on Burn (Hu et al., CGF 2020, §3.2).
 //!
-//! - [`autoencoder`]: Table 1 and the CPU preset; [`loss`]: eq. (4).
-//! - [`training_set`], [`train`]: mapped layouts, Adam, checkpoints that resume exactly.
+//! - [`autoencoder`]: the architectures, Table 1 and the CPU preset's spectral network
+//!   ([`spectral`], [`principal`]); [`loss`]: eq. (4).
+//! - [`train`]: one training loop for every network (schedule, seeded batches, checkpoints
+//!   that resume exactly, NaN stop, CSV log), and the autoencoder's step through it;
+//!   [`training_set`]: the mapped layouts it trains on.
 //! - [`artifact`]: the self-contained saved model; [`codec`]: encode / decode with it;
 //!   [`compact`]: the spectral basis in the compact form the codec decodes with.
 //! - [`fit`]: all of the above on a set of MERL tables.
@@ -17,6 +20,8 @@ pub mod fit;
 pub mod loss;
 pub mod preset;
 pub mod principal;
+mod record;
+pub mod seeded;
 pub mod spectral;
 pub mod timing;
 pub mod train;

@@ -43,23 +43,31 @@ pub fn masked_mse_centred(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use burn::tensor::Distribution;
+    use burn::tensor::TensorData;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
 
     #[test]
     fn the_centred_form_equals_the_plain_one() {
+        // Seeded values (not Burn's shared generator, which other tests seed concurrently).
         let device = Device::default();
         let shape = [2, 3, 4, 5];
-        let x = Tensor::<4>::random(shape, Distribution::Uniform(0.0, 2.0), &device);
-        let mu = Tensor::<4>::random(shape, Distribution::Uniform(0.0, 1.0), &device);
-        let dev = Tensor::<4>::random(shape, Distribution::Uniform(-1.0, 1.0), &device);
-        let mask = Tensor::<4>::random(shape, Distribution::Uniform(0.0, 1.0), &device)
-            .greater_elem(0.3)
-            .float();
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        let mut uniform = |lo: f32, hi: f32| {
+            let values: Vec<f32> = (0..120).map(|_| rng.random_range(lo..hi)).collect();
+            Tensor::<4>::from_data(TensorData::new(values, shape), &device)
+        };
+        let x = uniform(0.0, 2.0);
+        let mu = uniform(0.0, 1.0);
+        let dev = uniform(-1.0, 1.0);
+        let mask = uniform(0.0, 1.0).greater_elem(0.3).float();
         let valid: f32 = mask.clone().sum().into_scalar();
+        assert!(valid > 60.0 && valid < 120.0, "{valid} valid cells");
         let plain: f32 =
             masked_mse(dev.clone() + mu.clone(), x.clone(), mask.clone()).into_scalar();
         let centred: f32 =
             masked_mse_centred(dev, (x - mu) * mask.clone(), mask, f64::from(valid)).into_scalar();
+        assert!(plain > 0.1, "{plain}");
         assert!((plain - centred).abs() <= 1e-5 * plain.abs(), "{plain} vs {centred}");
     }
 

@@ -2,23 +2,21 @@
 //! training mean and masked to valid cells (the space the loss of eq. (4) is measured in): the
 //! basis of the `cpu` preset's spectral path ([`crate::spectral`]).
 //!
-//! The Gram route of PCA (as `deepbrdf-eval`'s baselines): G = R R^T over the n centred rows R
-//! in f64 (summed block by block in a fixed order, so the fit is deterministic), its
-//! eigenvectors V and values s^2, U = diag(1/s) V^T R. The coordinates of training row i are
+//! The Gram route of PCA shared with `deepbrdf-eval`'s baselines ([`deepbrdf_data::gram_pca`]):
+//! G = R R^T over the n centred rows R in f64 (summed block by block in a fixed order, so the
+//! fit is deterministic), its eigenvectors V and values s^2 (eigenvalues at the core's floor
+//! left out, their row of U zero), U = diag(1/s) V^T R. The coordinates of training row i are
 //! then `c_ij = s_j V_ij` and its squared distance to the span is `G_ii - |c_i|^2`.
 
 use crate::autoencoder::INPUT_VALUES;
 use crate::error::{ModelError, Result};
 use crate::training_set::TrainingSet;
+use deepbrdf_data::gram_pca::{leading_eigenpairs, ordered_block_sum};
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 
 /// Values per block of the Gram accumulation.
 const BLOCK: usize = 1 << 15;
-
-/// Eigenvalues below this fraction of the largest are treated as zero (their direction is left
-/// out, its row of U zero).
-const RELATIVE_EIGEN_FLOOR: f64 = 1e-12;
 
 /// Rows `(x_i - offset) * mask_i` of `data` over `range`, as an n x len matrix in f64.
 fn centred_block(
@@ -60,32 +58,20 @@ pub fn fit_basis(data: &TrainingSet, offset: &[f32], k: usize) -> Result<Princip
     }
     let blocks = INPUT_VALUES.div_ceil(BLOCK);
     let range = |b: usize| b * BLOCK..((b + 1) * BLOCK).min(INPUT_VALUES);
-    let parts: Vec<DMatrix<f64>> = (0..blocks)
-        .into_par_iter()
-        .map(|b| {
-            let x = centred_block(data, offset, range(b));
-            &x * x.transpose()
-        })
-        .collect();
-    let gram = parts.into_iter().fold(DMatrix::<f64>::zeros(n, n), |a, b| a + b);
-    let gram = (&gram + gram.transpose()) * 0.5;
+    let gram = ordered_block_sum(blocks, n, |b| {
+        let x = centred_block(data, offset, range(b));
+        &x * x.transpose()
+    });
     let gram_diagonal: Vec<f64> = (0..n).map(|i| gram[(i, i)]).collect();
-    let eig = nalgebra::SymmetricEigen::try_new(gram, 1e-14, 10_000).ok_or_else(|| {
-        ModelError::Invalid("the Gram matrix eigendecomposition did not converge".into())
-    })?;
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
-    let floor = eig.eigenvalues[order[0]].max(0.0) * RELATIVE_EIGEN_FLOOR;
+    let pairs = leading_eigenpairs(gram, k)?;
     // W = V_k diag(1/s) (n x k), zero columns past the rank; coordinates s_j V_ij.
     let mut w = DMatrix::<f64>::zeros(n, k);
     let mut coefficients = vec![vec![0f32; k]; n];
-    for (j, &e) in order.iter().take(k).enumerate() {
-        let lambda = eig.eigenvalues[e];
-        if lambda > floor && lambda > 0.0 {
-            let s = lambda.sqrt();
+    for (j, &s) in pairs.sigmas.iter().enumerate() {
+        if s > 0.0 {
             for i in 0..n {
-                w[(i, j)] = eig.eigenvectors[(i, e)] / s;
-                coefficients[i][j] = (eig.eigenvectors[(i, e)] * s) as f32;
+                w[(i, j)] = pairs.vectors[(i, j)] / s;
+                coefficients[i][j] = (pairs.vectors[(i, j)] * s) as f32;
             }
         }
     }

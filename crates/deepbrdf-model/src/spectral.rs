@@ -18,8 +18,8 @@ use burn::prelude::*;
 use burn::tensor::activation::leaky_relu;
 use burn::tensor::TensorData;
 
-use crate::autoencoder::INPUT_VALUES;
 use crate::error::ModelError;
+use deepbrdf_data::merl::VALUES as INPUT_VALUES;
 
 /// The fixed basis and the two coefficient-space networks.
 #[derive(Module, Debug)]
@@ -73,6 +73,11 @@ impl SpectralPath {
     /// K, the number of directions.
     pub fn size(&self) -> usize {
         self.size
+    }
+
+    /// k, the latent dimension.
+    pub fn latent(&self) -> usize {
+        self.latent
     }
 
     /// Sets the basis: `size` rows of `540 * 90 * 90` values in layout order.

@@ -15,10 +15,11 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::artifact::{ModelArtifact, Provenance};
 use crate::autoencoder::{AutoencoderConfig, INPUT_VALUES};
-use crate::codec::{grid_mask, DeepBrdf};
+use crate::codec::DeepBrdf;
 use crate::error::{ModelError, Result};
-use crate::train::{coefficient_gradients, gradients};
+use crate::train::autoencoder::{coefficient_gradients, gradients};
 use crate::training_set::TrainingSet;
+use deepbrdf_data::merl::grid::valid_mask;
 
 /// Median and all timings of repeated runs, in seconds.
 #[derive(Debug, Clone)]
@@ -56,15 +57,15 @@ pub fn training_steps(
     let device = device.clone().autodiff();
     let set = synthetic_set(batch)?;
     let mut model = config.init_seeded(0, &device)?;
-    if config.mean_offset {
+    if config.mean_offset() {
         model = model.with_offset(&set.mean())?;
     }
     let offset = model.offset();
-    let fit = match (config.spectral_basis, &offset) {
-        (Some(size), Some(mean)) => {
-            let fit = crate::principal::fit_basis(&set, mean, size)?;
+    let fit = match (config.spectral_config(), &offset) {
+        (Some(spectral), Some(mean)) => {
+            let fit = crate::principal::fit_basis(&set, mean, spectral.directions)?;
             model = model.with_basis(&fit.basis)?;
-            Some(fit).filter(|_| config.spectral_only())
+            Some(fit)
         }
         _ => None,
     };
@@ -94,7 +95,7 @@ pub fn training_steps(
 
 /// `n` BRDFs of seeded random mapped values on the MERL grid's mask.
 fn synthetic_set(n: usize) -> Result<TrainingSet> {
-    let mask = mask_layout(&grid_mask());
+    let mask = mask_layout(valid_mask());
     let mut rng = ChaCha8Rng::seed_from_u64(0);
     let inputs =
         (0..n).map(|_| mask.iter().map(|&m| m * rng.random_range(0.0..2.0f32)).collect()).collect();
@@ -122,13 +123,13 @@ pub struct DecodeTiming {
 pub fn decode(config: &AutoencoderConfig, repeats: usize, device: &Device) -> Result<DecodeTiming> {
     let device = device.clone().without_autodiff();
     let mut model = config.init_seeded(0, &device)?;
-    let valid = mask_layout(&grid_mask());
+    let valid = mask_layout(valid_mask());
     let mut rng = ChaCha8Rng::seed_from_u64(1);
-    if config.mean_offset {
+    if config.mean_offset() {
         let offset: Vec<f32> = valid.iter().map(|&m| m * rng.random_range(-1.0..1.0f32)).collect();
         model = model.with_offset(&offset)?;
     }
-    if let Some(size) = config.spectral_basis {
+    if let Some(size) = config.spectral_config().map(|s| s.directions) {
         let scale = 1.0 / (INPUT_VALUES as f32).sqrt();
         let basis: Vec<f32> = (0..size * INPUT_VALUES)
             .map(|i| valid[i % INPUT_VALUES] * scale * rng.random_range(-1.0..1.0f32))

@@ -21,7 +21,9 @@ pub mod shape;
 pub mod sheet;
 pub mod sky;
 
-pub use brdf::{Brdf, Ggx, Lambertian, MerlBrdf, MerlLookup, SamplingLobe, Sum};
+pub use brdf::{
+    Brdf, Ggx, Lambertian, MerlBrdf, MerlLookup, MerlSampling, SamplingLobe, Sum, TableSampler,
+};
 pub use camera::{Camera, Projection};
 pub use error::{RenderError, Result};
 pub use image::{Image, Srgb8Image, Tonemap};

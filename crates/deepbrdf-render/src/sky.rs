@@ -174,8 +174,8 @@ pub fn sun_transmittance(theta_s: f64, turbidity: f64) -> Rgb {
 #[derive(Clone, Copy, Debug)]
 struct SkyCell {
     radiance: [f32; 3],
-    /// `(1 - sun_prob) * pdf(u, v) / (4 pi)`: solid-angle density times `v`.
-    pdf_v: f32,
+    /// `pdf(u, v) / (4 pi)`: the sky map's solid-angle density times `v`.
+    sky_pdf_v: f32,
 }
 
 /// The sun and sky as an environment light, tabulated and ready for importance sampling.
@@ -185,8 +185,8 @@ pub struct SunSky {
     width: usize,
     height: usize,
     /// Per map cell, row-major over (v = sqrt(1 - cos theta), azimuth): scaled sky radiance and
-    /// the sky-sampling density times `v` (divide by `v` for solid angle), precomputed so one
-    /// lookup gives both.
+    /// the sky map's sampling density times `v` (divide by `v` for solid angle), precomputed so
+    /// one lookup gives both.
     cells: Vec<SkyCell>,
     distribution: Distribution2D,
     sun: Vec3,
@@ -271,8 +271,7 @@ impl SunSky {
             .enumerate()
             .map(|(i, rgb)| SkyCell {
                 radiance: rgb.map(|x| (f64::from(x) * scale) as f32),
-                pdf_v: ((1.0 - sun_prob) * distribution.pdf_cell(i % width, i / width) / (4.0 * PI))
-                    as f32,
+                sky_pdf_v: (distribution.pdf_cell(i % width, i / width) / (4.0 * PI)) as f32,
             })
             .collect();
         Ok(Self {
@@ -349,29 +348,64 @@ impl SunSky {
     /// Radiance from `dir` and the density of [`SunSky::sample`] there, in one map lookup.
     #[inline]
     pub fn eval(&self, dir: Vec3) -> (Rgb, f64) {
-        let (mut l, mut p) = ([0.0; 3], 0.0);
+        let (l, p_sun, p_sky) = self.eval_parts(dir);
+        (l, self.sun_prob * p_sun + (1.0 - self.sun_prob) * p_sky)
+    }
+
+    /// Draws a direction in the sun disk, uniform in its cone: `(direction, radiance,
+    /// density 1 / sun solid angle)` (the radiance includes the sky behind the disk).
+    #[inline]
+    pub fn sample_sun(&self, u: [f64; 2]) -> (Vec3, Rgb, f64) {
+        let cos_t = 1.0 - u[0] * (1.0 - self.cos_sun_radius);
+        let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+        let (s, c) = (2.0 * PI * u[1]).sin_cos();
+        let dir = self.sun_frame.to_world(Vec3::new(sin_t * c, sin_t * s, cos_t));
+        (dir, self.eval(dir).0, 1.0 / self.sun_solid_angle)
+    }
+
+    /// Draws a direction from the sky map alone, in proportion to luminance: `(direction,
+    /// radiance (plus the sun's inside its disk), density of the map alone)`.
+    #[inline]
+    pub fn sample_sky(&self, u: [f64; 2]) -> (Vec3, Rgb, f64) {
+        let (uv, (col, row), _) = self.distribution.sample(u);
+        let v = uv[1];
+        let z = 1.0 - v * v;
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        let (sp, cp) = (2.0 * PI * uv[0]).sin_cos();
+        let dir = Vec3::new(r * cp, r * sp, z);
+        // The cell is known: no angle computations, the sky's part read directly.
+        let cell = &self.cells[row * self.width + col];
+        let p = if v > 0.0 { f64::from(cell.sky_pdf_v) / v } else { 0.0 };
+        let mut l = cell.radiance.map(f64::from);
+        if self.in_sun(dir) {
+            for (a, s) in l.iter_mut().zip(self.sun_radiance) {
+                *a += s;
+            }
+        }
+        (dir, l, p)
+    }
+
+    /// Radiance from `dir` and the densities of [`SunSky::sample_sun`] and
+    /// [`SunSky::sample_sky`] there, in one map lookup.
+    #[inline]
+    pub fn eval_parts(&self, dir: Vec3) -> (Rgb, f64, f64) {
+        let (mut l, mut p_sky, mut p_sun) = ([0.0; 3], 0.0, 0.0);
         if dir.z > 0.0 {
             let (col, row) = self.cell(dir);
             let cell = &self.cells[row * self.width + col];
             let v = (1.0 - dir.z).max(0.0).sqrt();
             l = cell.radiance.map(f64::from);
             if v > 0.0 {
-                p = f64::from(cell.pdf_v) / v;
+                p_sky = f64::from(cell.sky_pdf_v) / v;
             }
         }
-        self.add_sun(dir, l, p)
-    }
-
-    /// Adds the sun's radiance and sampling density at `dir`, if it lies in the disk.
-    #[inline]
-    fn add_sun(&self, dir: Vec3, mut l: Rgb, mut p: f64) -> (Rgb, f64) {
         if self.in_sun(dir) {
             for (a, s) in l.iter_mut().zip(self.sun_radiance) {
                 *a += s;
             }
-            p += self.sun_prob / self.sun_solid_angle;
+            p_sun = 1.0 / self.sun_solid_angle;
         }
-        (l, p)
+        (l, p_sun, p_sky)
     }
 
     /// Draws a direction from `u` uniform in [0,1)^2: the sun disk (uniform in its cone) with
@@ -379,28 +413,13 @@ impl SunSky {
     /// its radiance and its density ([`SunSky::pdf`]).
     #[inline]
     pub fn sample(&self, u: [f64; 2]) -> (Vec3, Rgb, f64) {
-        if u[0] < self.sun_prob {
-            let u0 = u[0] / self.sun_prob;
-            let cos_t = 1.0 - u0 * (1.0 - self.cos_sun_radius);
-            let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
-            let (s, c) = (2.0 * PI * u[1]).sin_cos();
-            let dir = self.sun_frame.to_world(Vec3::new(sin_t * c, sin_t * s, cos_t));
-            let (l, p) = self.eval(dir);
-            (dir, l, p)
+        let dir = if u[0] < self.sun_prob {
+            self.sample_sun([u[0] / self.sun_prob, u[1]]).0
         } else {
-            let u0 = (u[0] - self.sun_prob) / (1.0 - self.sun_prob);
-            let (uv, (col, row), _) = self.distribution.sample([u0, u[1]]);
-            let v = uv[1];
-            let z = 1.0 - v * v;
-            let r = (1.0 - z * z).max(0.0).sqrt();
-            let (sp, cp) = (2.0 * PI * uv[0]).sin_cos();
-            let dir = Vec3::new(r * cp, r * sp, z);
-            // The cell is known: no angle computations, the sky's part read directly.
-            let cell = &self.cells[row * self.width + col];
-            let p = if v > 0.0 { f64::from(cell.pdf_v) / v } else { 0.0 };
-            let (l, p) = self.add_sun(dir, cell.radiance.map(f64::from), p);
-            (dir, l, p)
-        }
+            self.sample_sky([(u[0] - self.sun_prob) / (1.0 - self.sun_prob), u[1]]).0
+        };
+        let (l, p) = self.eval(dir);
+        (dir, l, p)
     }
 }
 
@@ -494,6 +513,48 @@ mod tests {
         }
         let total = total * 4.0 * PI / (nz * nphi) as f64;
         assert!((total - 1.0).abs() < 0.01, "{total}");
+    }
+
+    #[test]
+    fn sun_and_sky_strategies_match_their_densities() {
+        let sky = SunSky::new(SunSkyConfig { sun_radius_deg: 5.0, ..Default::default() }).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(6);
+        let n = 100_000;
+        // E[L / p] over each strategy's samples estimates the integral of the luminance over its
+        // support: the sun strategy's covers the disk, the sky map's the upper hemisphere.
+        let (mut disk, mut hemisphere) = (0.0, 0.0);
+        for _ in 0..n {
+            let (d, l, p) = sky.sample_sun([rng.random(), rng.random()]);
+            let (l2, p_sun, _) = sky.eval_parts(d);
+            assert!(sky.in_sun(d) && l == l2 && (p - p_sun).abs() <= 1e-12 * p);
+            disk += luminance(l) / p;
+            let (d, l, p) = sky.sample_sky([rng.random(), rng.random()]);
+            let (l2, _, p_sky) = sky.eval_parts(d);
+            assert!(d.z >= 0.0 && l == l2 && (p - p_sky).abs() <= 1e-6 * p, "{p} {p_sky}");
+            hemisphere += luminance(sky.sky_radiance(d)) / p;
+        }
+        // Reference: stratified uniform sampling of the upper hemisphere.
+        let (mut ref_disk, mut ref_hemisphere) = (0.0, 0.0);
+        let (nz, nphi) = (1000, 1000);
+        for i in 0..nz {
+            for j in 0..nphi {
+                let z = (i as f64 + rng.random::<f64>()) / nz as f64;
+                let phi = 2.0 * PI * (j as f64 + rng.random::<f64>()) / nphi as f64;
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                let d = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+                let cell = 2.0 * PI / (nz * nphi) as f64;
+                ref_hemisphere += luminance(sky.sky_radiance(d)) * cell;
+                if sky.in_sun(d) {
+                    ref_disk += luminance(sky.radiance(d)) * cell;
+                }
+            }
+        }
+        let (disk, hemisphere) = (disk / n as f64, hemisphere / n as f64);
+        assert!((disk / ref_disk - 1.0).abs() < 0.02, "{disk} vs {ref_disk}");
+        assert!(
+            (hemisphere / ref_hemisphere - 1.0).abs() < 0.02,
+            "{hemisphere} vs {ref_hemisphere}"
+        );
     }
 
     #[test]

@@ -8,7 +8,7 @@
 use crate::mapped_input::InputCache;
 use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::{MerlTable, Progress};
-use deepbrdf_eval::harness::{Codec, Method, TrainingSet};
+use deepbrdf_eval::harness::{Codec, FoldTraining, Method};
 use deepbrdf_eval::{EvalError, Result};
 use deepbrdf_model::artifact::MODEL_DIR;
 use deepbrdf_model::burn::tensor::Device;
@@ -120,7 +120,7 @@ impl DeepMethod {
     fn fit_in(
         &self,
         fold: usize,
-        train: &TrainingSet<'_>,
+        train: &FoldTraining<'_>,
         k: usize,
         cache: &Arc<InputCache>,
         set: &mut Option<MappedSet>,
@@ -262,13 +262,13 @@ impl Method for DeepMethod {
     ) -> Result<Box<dyn Codec>> {
         let fold = self.next_fold.load(Ordering::SeqCst);
         let reference = MedianReference::from_tables(train)?;
-        let set = TrainingSet { tables: train, names, reference: &reference };
+        let set = FoldTraining { tables: train, names, reference: &reference };
         self.fit_in(fold, &set, k, &Arc::default(), &mut None, progress)
     }
 
     fn fit_fold(
         &self,
-        train: &TrainingSet<'_>,
+        train: &FoldTraining<'_>,
         ks: &[usize],
         progress: &dyn Progress,
     ) -> Result<Vec<Box<dyn Codec>>> {

@@ -17,13 +17,10 @@ impl LatentFile {
         Self { model_id: model_id.into(), material: material.into(), k: latent.len(), latent }
     }
 
-    /// Writes the file atomically (temporary file + rename).
+    /// Writes the file atomically ([`deepbrdf_data::files::write_atomic`]).
     pub fn save(&self, path: &Path) -> anyhow::Result<()> {
         let text = serde_json::to_string_pretty(self)?;
-        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let tmp = path.with_file_name(format!(".{name}.tmp{}", std::process::id()));
-        std::fs::write(&tmp, text + "\n").with_context(|| format!("writing {}", tmp.display()))?;
-        std::fs::rename(&tmp, path).with_context(|| format!("writing {}", path.display()))?;
+        deepbrdf_data::files::write_atomic(path, (text + "\n").as_bytes())?;
         Ok(())
     }
 

@@ -4,8 +4,8 @@
 //! reduced inputs; all of them start from this, so each table is mapped once per fold.
 
 use deepbrdf_data::augment::fill_missing_layout;
-use deepbrdf_data::layout::{mask_layout, to_layout};
 use deepbrdf_data::mapping::MedianReference;
+use deepbrdf_data::network_input::mapped_layout;
 use deepbrdf_data::MerlTable;
 use deepbrdf_model::{DeepBrdf, Result};
 use std::sync::{Arc, Mutex};
@@ -20,10 +20,8 @@ pub struct MappedInput {
 impl MappedInput {
     /// Maps `table` with `reference` (eq. 1) into the §3.2 layout, as `DeepBrdf::encode` does.
     pub fn new(table: &MerlTable, reference: &MedianReference) -> Self {
-        Self {
-            input: Arc::new(to_layout(&reference.map(table))),
-            mask: Arc::new(mask_layout(&table.mask())),
-        }
+        let (input, mask) = mapped_layout(table, reference);
+        Self { input: Arc::new(input), mask: Arc::new(mask) }
     }
 
     /// Eq. (2) of the full input.

@@ -9,7 +9,7 @@
 
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::baseline::{BaselineBasis, MappingKind};
-use deepbrdf_eval::harness::{Codec, Method, TrainingSet};
+use deepbrdf_eval::harness::{Codec, FoldTraining, Method};
 use deepbrdf_eval::{EvalError, Result};
 use std::sync::{Arc, Mutex};
 
@@ -57,7 +57,7 @@ impl Method for NestedBaseline {
 
     fn fit_fold(
         &self,
-        train: &TrainingSet<'_>,
+        train: &FoldTraining<'_>,
         ks: &[usize],
         progress: &dyn Progress,
     ) -> Result<Vec<Box<dyn Codec>>> {
@@ -153,11 +153,11 @@ mod tests {
         let refs: Vec<&MerlTable> = tables.iter().collect();
         let names: Vec<String> = (0..3).map(|i| format!("m{i}")).collect();
         let reference = MedianReference::from_tables(&refs).unwrap();
-        let set = TrainingSet { tables: &refs, names: &names, reference: &reference };
+        let set = FoldTraining { tables: &refs, names: &names, reference: &reference };
         let ks = [1, 2];
         for (ours, theirs) in [
-            (NestedBaseline::pca(), deepbrdf_eval::pca::Pca::method()),
-            (NestedBaseline::ipca(), deepbrdf_eval::ipca::Ipca::method()),
+            (NestedBaseline::pca(), deepbrdf_eval::baseline::BaselineMethod::pca()),
+            (NestedBaseline::ipca(), deepbrdf_eval::baseline::BaselineMethod::ipca()),
         ] {
             assert_eq!(ours.name(), theirs.name());
             let a = ours.fit_fold(&set, &ks, &Silent).unwrap();

@@ -45,7 +45,7 @@ pub fn update_file(path: &Path, begin: &str, end: &str, block: &str) -> anyhow::
         std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let new = replace_block(&text, begin, end, block)
         .with_context(|| format!("updating the generated block of {}", path.display()))?;
-    deepbrdf_eval::figures::write_atomic_file(path, new.as_bytes())?;
+    deepbrdf_data::files::write_atomic(path, new.as_bytes())?;
     Ok(())
 }
 

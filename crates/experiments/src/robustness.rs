@@ -11,8 +11,9 @@
 use crate::deep_method::{DeepMethod, NAME};
 use crate::mapped_input::MappedInput;
 use deepbrdf_data::augment::{kept_slices, SliceSelection};
+use deepbrdf_data::files::write_atomic;
 use deepbrdf_data::{MerlTable, Progress};
-use deepbrdf_eval::figures::{write_atomic_file, write_chart, LineChart, Series};
+use deepbrdf_eval::figures::{write_chart, LineChart, Series};
 use deepbrdf_eval::harness::{Fold, Measure, Results, Yardstick};
 use deepbrdf_model::DeepBrdf;
 use std::fmt::Write as _;
@@ -229,7 +230,7 @@ impl Robustness {
                 r.mapped_mse
             );
         }
-        write_atomic_file(&dir.join("robustness.csv"), csv.as_bytes())?;
+        write_atomic(&dir.join("robustness.csv"), csv.as_bytes())?;
         let columns = Self::columns();
         let series = self
             .rows()
@@ -265,5 +266,88 @@ fn csv_field(s: &str) -> String {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {
         s.to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record(
+        every: usize,
+        method: &str,
+        k: Option<usize>,
+        material: &str,
+        v: f64,
+    ) -> RobustnessRecord {
+        RobustnessRecord {
+            every,
+            method: method.into(),
+            k,
+            fold: 0,
+            material: material.into(),
+            mapped_mse: v,
+        }
+    }
+
+    /// Two materials, DeepBRDF at k = 2 from all slices and from 1/3; the fill at 1/3 only.
+    fn sample() -> Robustness {
+        Robustness {
+            ks: vec![2],
+            records: vec![
+                record(1, NAME, Some(2), "a", 1e-3),
+                record(1, NAME, Some(2), "b, coated", 3e-3),
+                record(3, NEAREST_FILL, None, "a", 0.5),
+                record(3, NEAREST_FILL, None, "b, coated", 0.25),
+                record(3, NAME, Some(2), "a", 2e-3),
+                record(3, NAME, Some(2), "b, coated", 4e-3),
+            ],
+            seconds: 1.0,
+        }
+    }
+
+    #[test]
+    fn means_are_over_materials_of_one_cell_of_the_table() {
+        let r = sample();
+        assert_eq!(r.mean(1, NAME, Some(2)), Some(2e-3));
+        assert_eq!(r.mean(3, NEAREST_FILL, None), Some(0.375));
+        assert_eq!(r.mean(3, NAME, Some(2)), Some(3e-3));
+        assert_eq!(r.mean(9, NAME, Some(2)), None);
+        assert_eq!(r.mean(3, NAME, Some(5)), None);
+    }
+
+    #[test]
+    fn the_table_has_one_row_per_method_and_k_and_marks_exact_and_missing_cells() {
+        let table = sample().table();
+        let lines: Vec<&str> = table.lines().collect();
+        assert_eq!(lines[0], "| input → | all slices | 1/3 of the slices | 1/9 of the slices |");
+        assert_eq!(lines[1], "|---|---:|---:|---:|");
+        // The fill is exact on the full input; nothing was measured at 1/9.
+        assert_eq!(lines[2], format!("| {NEAREST_FILL} | 0 (exact) | 3.7500e-1 | - |"));
+        assert_eq!(lines[3], format!("| {NAME} k = 2 | 2.0000e-3 | 3.0000e-3 | - |"));
+        assert_eq!(lines.len(), 4);
+    }
+
+    #[test]
+    fn the_csv_holds_every_record_exactly_and_quotes_fields() {
+        let dir = tempfile::tempdir().unwrap();
+        let r = sample();
+        r.write(dir.path()).unwrap();
+        let csv = std::fs::read_to_string(dir.path().join("robustness.csv")).unwrap();
+        let mut lines = csv.lines();
+        assert_eq!(lines.next(), Some("input,method,k,fold,material,mapped_mse"));
+        let rows: Vec<&str> = lines.collect();
+        assert_eq!(rows.len(), r.records.len());
+        for (line, rec) in rows.iter().zip(&r.records) {
+            let quoted = line.contains("\"b, coated\"");
+            assert_eq!(quoted, rec.material.contains(','), "{line}");
+            let value: f64 = line.rsplit(',').next().unwrap().parse().unwrap();
+            assert_eq!(value, rec.mapped_mse, "{line}");
+            assert!(line.starts_with(&format!("1/{},", rec.every)), "{line}");
+            let k = rec.k.map(|k| k.to_string()).unwrap_or_default();
+            assert!(line.contains(&format!(",{k},0,")), "{line}");
+        }
+        assert!(dir.path().join("robustness.png").is_file());
+        assert!(dir.path().join("robustness.svg").is_file());
     }
 }

@@ -1,7 +1,7 @@
 //! The scene and rendering arguments shared by `render`, `compare` and `sheet`:
 //! `--shape`, `--light`, `--view`, `--fov`, `--size`, `--spp`, `--seed`, `--exposure`.
 use anyhow::Context;
-use deepbrdf_render::{LightSpec, Projection, RenderSettings, SceneConfig, Shape, Tonemap};
+use deepbrdf_render::{LightSpec, Projection, RenderSettings, Scene, SceneConfig, Shape, Tonemap};
 
 #[derive(Debug, Clone, clap::Args)]
 pub struct SceneArgs {
@@ -34,9 +34,42 @@ pub struct SceneArgs {
     pub exposure: f32,
 }
 
+/// Everything a rendering command sets up from [`SceneArgs`]: the scene's description, the built
+/// scene, the render settings and the tonemapping.
+pub struct SceneSetup {
+    pub config: SceneConfig,
+    pub scene: Scene,
+    pub settings: RenderSettings,
+    pub tonemap: Tonemap,
+}
+
+impl SceneSetup {
+    /// `"256x256 sun ... on a sphere, 64 spp"`, as the commands print it.
+    pub fn description(&self) -> String {
+        format!(
+            "{}x{} {} on a {}, {} spp",
+            self.settings.size,
+            self.settings.size,
+            self.config.light,
+            self.config.shape,
+            self.settings.spp
+        )
+    }
+}
+
 impl SceneArgs {
+    /// The scene, settings (`default_size` when `--size` is not given) and tonemapping of these
+    /// arguments, checked and built: the one setup of `render`, `compare` and `sheet`.
+    pub fn setup(&self, default_size: u32) -> anyhow::Result<SceneSetup> {
+        let config = self.scene()?;
+        let settings = self.settings(default_size);
+        let tonemap = self.tonemap()?;
+        let scene = config.build()?;
+        Ok(SceneSetup { config, scene, settings, tonemap })
+    }
+
     /// The scene these arguments describe.
-    pub fn scene(&self) -> anyhow::Result<SceneConfig> {
+    fn scene(&self) -> anyhow::Result<SceneConfig> {
         let shape: Shape = self.shape.parse()?;
         let light: LightSpec = self.light.parse()?;
         let (theta, phi) = self
@@ -53,7 +86,7 @@ impl SceneArgs {
     }
 
     /// Render settings, with `default_size` when `--size` is not given.
-    pub fn settings(&self, default_size: u32) -> RenderSettings {
+    fn settings(&self, default_size: u32) -> RenderSettings {
         RenderSettings {
             size: self.size.unwrap_or(default_size),
             spp: self.spp,
@@ -63,7 +96,7 @@ impl SceneArgs {
     }
 
     /// The tonemapping of PNG output.
-    pub fn tonemap(&self) -> anyhow::Result<Tonemap> {
+    fn tonemap(&self) -> anyhow::Result<Tonemap> {
         anyhow::ensure!(
             self.exposure.is_finite() && self.exposure > 0.0,
             "--exposure {} must be positive",

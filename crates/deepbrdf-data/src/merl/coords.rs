@@ -9,7 +9,7 @@
 //! wi and wo leaves theta_h, phi_h, theta_d unchanged and shifts phi_d by pi, which is why MERL
 //! folds phi_d into [0, pi) (reciprocity).
 
-use super::table::{N_PHI_D, N_THETA_D, N_THETA_H};
+use super::grid::{N_PHI_D, N_THETA_D, N_THETA_H};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// A direction pair in Rusinkiewicz's half/difference angles (radians).

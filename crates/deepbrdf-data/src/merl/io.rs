@@ -8,7 +8,8 @@
 //! [`read_merl`] / [`write_merl`] convert to and from the f32 [`MerlTable`] in physical units.
 //! Sizes are checked before anything is allocated and writes are atomic.
 
-use super::table::{MerlTable, CELLS, INVALID_VALUE, MERL_SCALE, N_PHI_D, N_THETA_D, N_THETA_H};
+use super::grid::{CELLS, N_PHI_D, N_THETA_D, N_THETA_H};
+use super::table::{MerlTable, INVALID_VALUE, MERL_SCALE};
 use crate::error::{DataError, Result};
 use crate::files::{open_regular, read_exactly, write_atomic};
 use std::io::Read;
@@ -65,6 +66,18 @@ impl MerlFile {
         let path = path.as_ref();
         let bytes = read_checked(path)?;
         let stored = parse_values(path, &bytes, |_, v| v)?;
+        Ok(Self { stored })
+    }
+
+    /// Parses the bytes of a whole MERL file (what [`MerlFile::read`] reads from disk); `origin`
+    /// names the source in errors.
+    pub fn from_bytes(bytes: &[u8], origin: &Path) -> Result<Self> {
+        let mut header = [0u8; HEADER_BYTES];
+        if let Some(h) = bytes.get(..HEADER_BYTES) {
+            header.copy_from_slice(h);
+        }
+        check_header(origin, &header, bytes.len() as u64)?;
+        let stored = parse_values(origin, &bytes[HEADER_BYTES..], |_, v| v)?;
         Ok(Self { stored })
     }
 
@@ -153,7 +166,7 @@ fn stored(c: usize, physical: f32) -> f64 {
 
 /// "channel, cell (theta_h, theta_d, phi_d)" of a flat value index, for messages.
 fn describe(i: usize) -> String {
-    let (h, d, p) = super::table::cell_coords(i % CELLS);
+    let (h, d, p) = super::grid::cell_coords(i % CELLS);
     let channel = ["red", "green", "blue"][i / CELLS];
     format!("{channel} value at theta_h {h}, theta_d {d}, phi_d {p}")
 }
@@ -161,6 +174,17 @@ fn describe(i: usize) -> String {
 /// Reads the whole file after checking its header and its exact length.
 fn read_checked(path: &Path) -> Result<Vec<u8>> {
     let (mut file, len) = open_regular(path)?;
+    let mut header = [0u8; HEADER_BYTES];
+    if len >= HEADER_BYTES as u64 {
+        file.read_exact(&mut header).map_err(|e| DataError::io(path, e))?;
+    }
+    check_header(path, &header, len)?;
+    read_exactly(&mut file, path, FILE_BYTES - HEADER_BYTES)
+}
+
+/// Checks a MERL header (the first [`HEADER_BYTES`] of a file of `len` bytes; ignored when the
+/// file is shorter) and the file's exact length.
+fn check_header(path: &Path, header: &[u8; HEADER_BYTES], len: u64) -> Result<()> {
     if len == 0 {
         return Err(DataError::format(path, "empty file, expected a MERL .binary BRDF"));
     }
@@ -170,8 +194,6 @@ fn read_checked(path: &Path) -> Result<Vec<u8>> {
             format!("truncated: {len} bytes, shorter than the {HEADER_BYTES}-byte MERL header"),
         ));
     }
-    let mut header = [0u8; HEADER_BYTES];
-    file.read_exact(&mut header).map_err(|e| DataError::io(path, e))?;
     let dims: Vec<i32> =
         header.chunks_exact(4).map(|b| i32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
     if dims != DIMS {
@@ -199,7 +221,7 @@ fn read_checked(path: &Path) -> Result<Vec<u8>> {
             ),
         ));
     }
-    read_exactly(&mut file, path, FILE_BYTES - HEADER_BYTES)
+    Ok(())
 }
 
 /// Parses the 3 x [`CELLS`] f64 values of a MERL file's body with `convert(channel, stored)`,
@@ -393,5 +415,26 @@ mod tests {
         assert!(table.write(dir.path().join("missing").join("x.binary")).is_err());
         assert_eq!(MerlTable::read(&path)?, table);
         Ok(())
+    }
+
+    #[test]
+    fn mutated_files_are_rejected_or_read_never_a_panic() {
+        use crate::testing::mutate::{fuzz, inputs, Focus};
+        let full = file_bytes(|i| if i % 7 == 0 { -1.0 } else { (i as f64 * 1e-3).sin().abs() });
+        // A header plus a short stretch of body: mutants of it exercise the header, size and
+        // truncation checks without copying 35 MB each; one seed in 100 is the whole file, whose
+        // mutants reach the body's NaN/infinity and overflow checks.
+        let short = full[..HEADER_BYTES + 4096].to_vec();
+        let mut corpus = vec![short; 99];
+        corpus.push(full);
+        let n = inputs(300);
+        let origin = Path::new("fuzz.binary");
+        let report =
+            fuzz(&corpus, 2026, n, Focus { header: HEADER_BYTES, header_share: 0.9 }, |b| {
+                MerlFile::from_bytes(b, origin).and_then(|f| f.to_table())
+            });
+        eprintln!("MERL reader: {report:?}");
+        assert!(report.panics.is_empty(), "panics: {:?}", report.panics);
+        assert_eq!(report.accepted + report.rejected, n);
     }
 }

@@ -11,7 +11,8 @@ use super::coords::{
     continuous_phi_d, continuous_theta_d, continuous_theta_h, half_and_difference, phi_d_index,
     theta_d_index, theta_h_index,
 };
-use super::table::{cell_index, MerlTable, CELLS, N_PHI_D, N_THETA_D, N_THETA_H};
+use super::grid::{cell_index, CELLS, N_PHI_D, N_THETA_D, N_THETA_H};
+use super::table::MerlTable;
 
 /// (theta_h, theta_d, phi_d) of a direction pair, without the unneeded phi_h.
 #[inline]

@@ -6,8 +6,6 @@ pub mod io;
 pub mod lookup;
 pub mod table;
 
+pub use grid::{cell_coords, cell_index, CELLS, N_PHI_D, N_THETA_D, N_THETA_H, VALUES};
 pub use io::{read_merl, write_merl, MerlFile};
-pub use table::{
-    cell_coords, cell_index, MerlTable, CELLS, INVALID_VALUE, MERL_SCALE, N_PHI_D, N_THETA_D,
-    N_THETA_H, VALUES,
-};
+pub use table::{MerlTable, INVALID_VALUE, MERL_SCALE};

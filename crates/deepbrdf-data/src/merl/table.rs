@@ -5,20 +5,8 @@
 //! the channel's colour scale ([`MERL_SCALE`]). Cells where the incoming or outgoing direction is
 //! below the horizon are invalid; they hold a negative value, as in MERL's own files.
 
+use super::grid::{cell_coords, cell_index, cell_is_valid, CELLS, ROW, VALUES};
 use crate::error::{DataError, Result};
-
-/// Number of theta_h samples (square-root warped over [0, pi/2)).
-pub const N_THETA_H: usize = 90;
-/// Number of theta_d samples (uniform over [0, pi/2)).
-pub const N_THETA_D: usize = 90;
-/// Number of phi_d samples (uniform over [0, pi); reciprocity folds [pi, 2pi) onto it).
-pub const N_PHI_D: usize = 180;
-/// Cells per colour channel: 1,458,000.
-pub const CELLS: usize = N_THETA_H * N_THETA_D * N_PHI_D;
-/// Values per table, all three channels: 4,374,000.
-pub const VALUES: usize = 3 * CELLS;
-/// Cells in one theta_h row of the grid (all theta_d and phi_d): 16,200.
-pub const ROW: usize = N_THETA_D * N_PHI_D;
 
 /// Colour scales of MERL's reference reader (`BRDFRead.cpp`, Matusik et al. 2003): the stored value
 /// of channel c times `MERL_SCALE[c]` is reflectance in 1/sr. Red 1/1500, green 1.15/1500,
@@ -28,19 +16,6 @@ pub const MERL_SCALE: [f64; 3] = [1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0];
 /// Value stored in invalid (below-horizon) cells of tables this crate writes, in physical units.
 /// Any negative value marks a cell invalid when reading.
 pub const INVALID_VALUE: f32 = -1.0;
-
-/// Flat index of a cell within one channel, in MERL's file order
-/// (`phi_d + theta_d * 180 + theta_h * 180 * 90`).
-#[inline]
-pub fn cell_index(theta_h: usize, theta_d: usize, phi_d: usize) -> usize {
-    (theta_h * N_THETA_D + theta_d) * N_PHI_D + phi_d
-}
-
-/// Inverse of [`cell_index`]: `(theta_h, theta_d, phi_d)` indices of a flat cell index.
-#[inline]
-pub fn cell_coords(cell: usize) -> (usize, usize, usize) {
-    (cell / (N_THETA_D * N_PHI_D), (cell / N_PHI_D) % N_THETA_D, cell % N_PHI_D)
-}
 
 /// A full MERL BRDF in physical units: channel-major, each channel in MERL's file order.
 #[derive(Clone, PartialEq)]
@@ -98,7 +73,7 @@ impl MerlTable {
         let mut values = vec![INVALID_VALUE; VALUES];
         for cell in 0..CELLS {
             let (h, d, p) = cell_coords(cell);
-            if crate::merl::grid::cell_is_valid(h, d, p) {
+            if cell_is_valid(h, d, p) {
                 let rgb = f(h, d, p);
                 for c in 0..3 {
                     values[c * CELLS + cell] = rgb[c];

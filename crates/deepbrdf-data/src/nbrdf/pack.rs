@@ -182,4 +182,34 @@ mod tests {
         assert!(err(&fewer).contains("x.nbrdf"));
         assert!(pack(&[net("a", 0.3), net("a", 0.5)]).is_err());
     }
+
+    #[test]
+    fn mutated_packs_are_rejected_or_read_never_a_panic() {
+        use crate::testing::mutate::{fuzz, inputs, Focus};
+        // The smallest bundled pack, and a three-network one, as seeds.
+        let corpus = vec![
+            include_bytes!("../../assets/nbrdf/nielsen2015.nbrdf").to_vec(),
+            pack(&[net("b", 0.3), net("a", 0.7), net("c-3", 1.1)]).expect("pack"),
+        ];
+        let origin = Path::new("fuzz.nbrdf");
+        let n = inputs(1_000);
+        let focus = Focus { header: HEADER + 64, header_share: 0.7 };
+        // As mutated: the checksum catches payload damage.
+        let raw = fuzz(&corpus, 11, n, focus, |b| unpack(b, origin));
+        // With the checksum recomputed over the mutated payload, so the payload parser itself
+        // (name lengths, UTF-8, counts, trailing bytes, parameter values) sees the damage.
+        let resealed = fuzz(&corpus, 12, n, focus, |b| {
+            let mut b = b.to_vec();
+            if b.len() >= HEADER {
+                let sum = Sha256::digest(&b[HEADER..]);
+                b[16..48].copy_from_slice(&sum);
+            }
+            unpack(&b, origin)
+        });
+        eprintln!("NBRDF pack reader: raw {raw:?}, resealed {resealed:?}");
+        for report in [&raw, &resealed] {
+            assert!(report.panics.is_empty(), "panics: {:?}", report.panics);
+        }
+        assert!(resealed.rejected > 0 && resealed.accepted > 0, "{resealed:?}");
+    }
 }

@@ -10,7 +10,7 @@
 
 use super::network::{Network, HIDDEN, INPUTS, OUTPUTS};
 use crate::error::{DataError, Result};
-use crate::merl::table::ROW;
+use crate::merl::grid::ROW;
 use crate::merl::{grid, MerlTable, N_PHI_D, N_THETA_D, N_THETA_H};
 
 /// Version of the tabulation procedure. Bump it whenever the values this module produces change

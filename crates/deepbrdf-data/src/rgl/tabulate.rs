@@ -8,7 +8,7 @@
 use super::RglBrdf;
 use crate::error::{DataError, Result};
 use crate::merl::coords::HalfDiff;
-use crate::merl::table::ROW;
+use crate::merl::grid::ROW;
 use crate::merl::{grid, MerlTable, N_PHI_D, N_THETA_D};
 
 /// Version of the RGL tabulation. Bump it whenever the values this module (or the evaluator)

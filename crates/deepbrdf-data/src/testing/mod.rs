@@ -2,6 +2,7 @@
 //! ([`analytic`]) and a small synthetic family of materials ([`family`]).
 pub mod analytic;
 pub mod family;
+pub mod mutate;
 
 pub use analytic::*;
 pub use family::{sparse_set, sparse_table, synthetic_set, synthetic_table, SPARSE_THETA_H};

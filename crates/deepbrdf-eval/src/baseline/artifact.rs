@@ -22,11 +22,10 @@
 
 use super::{BaselineBasis, Domain, Mapping};
 use crate::error::{EvalError, Result};
-use crate::ipca;
 use crate::pca::LinearBasis;
 use deepbrdf_data::merl::CELLS;
 use sha2::{Digest, Sha256};
-use std::io::{Read, Write};
+use std::io::Read;
 use std::path::Path;
 
 const MAGIC: &[u8; 8] = b"DBRDFLB1";
@@ -60,24 +59,7 @@ pub(super) fn save(b: &BaselineBasis, path: &Path) -> Result<()> {
     let digest = Sha256::digest(&out);
     out.extend_from_slice(&digest);
 
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let file_name = path
-        .file_name()
-        .ok_or_else(|| EvalError::Invalid(format!("{}: not a file path", path.display())))?;
-    let tmp = dir.join(format!(".{}.tmp", file_name.to_string_lossy()));
-    let write = || -> std::io::Result<()> {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(&out)?;
-        f.sync_all()
-    };
-    if let Err(e) = write() {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(EvalError::io(&tmp, e));
-    }
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        EvalError::io(path, e)
-    })
+    Ok(deepbrdf_data::files::write_atomic(path, &out)?)
 }
 
 /// Reads little-endian fields from a byte slice, failing with a format error at the end.
@@ -197,7 +179,7 @@ pub(super) fn load(path: &Path) -> Result<BaselineBasis> {
     let domain = Domain::from_cells(cells).map_err(|e| EvalError::format(path, e.to_string()))?;
     let mapping = if kind == 1 {
         let reference = r.f32s(dim)?;
-        let weights = ipca::cos_weights();
+        let weights = deepbrdf_data::merl::grid::cos_weights();
         let w = domain.cells().iter().map(|&c| weights[c as usize]).collect();
         Mapping::log_relative_from_parts(&domain, reference, w)
             .map_err(|e| EvalError::format(path, e.to_string()))?

@@ -25,7 +25,7 @@ pub enum MappingKind {
 pub enum Mapping {
     /// Traditional PCA's logarithm ([`pca::log_map`]).
     Log,
-    /// IPCA's log-relative mapping ([`ipca::log_relative`]).
+    /// IPCA's log-relative mapping ([`ipca::cosine_log_relative`]).
     LogRelative {
         /// rho_ref in row order (the per-value median of the training tables).
         reference: Vec<f32>,
@@ -35,11 +35,6 @@ pub enum Mapping {
 }
 
 impl Mapping {
-    /// The kind of a PCA baseline's mapping.
-    pub fn log_kind() -> MappingKind {
-        MappingKind::Log
-    }
-
     /// This mapping's kind.
     pub fn kind(&self) -> MappingKind {
         match self {
@@ -63,7 +58,7 @@ impl Mapping {
                 row[domain.row_index(c, m)] = reference[c * CELLS + cell as usize];
             }
         }
-        let weights = ipca::cos_weights();
+        let weights = deepbrdf_data::merl::grid::cos_weights();
         let cos_weight = domain.cells().iter().map(|&c| weights[c as usize]).collect::<Vec<_>>();
         debug_assert_eq!(cos_weight.len(), n);
         Self::log_relative_from_parts(domain, row, cos_weight)
@@ -109,7 +104,7 @@ impl Mapping {
                     let rho = f64::from(values[c * CELLS + cell]);
                     *o = match self {
                         Self::Log => pca::log_map(rho),
-                        Self::LogRelative { reference, cos_weight } => ipca::log_relative(
+                        Self::LogRelative { reference, cos_weight } => ipca::cosine_log_relative(
                             rho,
                             f64::from(reference[c * n + m]),
                             f64::from(cos_weight[m]),
@@ -142,11 +137,13 @@ impl Mapping {
                 let y = f64::from(row[c * n + m]);
                 let rho = match self {
                     Self::Log => pca::log_unmap(y),
-                    Self::LogRelative { reference, cos_weight } => ipca::log_relative_inverse(
-                        y,
-                        f64::from(reference[c * n + m]),
-                        f64::from(cos_weight[m]),
-                    ),
+                    Self::LogRelative { reference, cos_weight } => {
+                        ipca::cosine_log_relative_inverse(
+                            y,
+                            f64::from(reference[c * n + m]),
+                            f64::from(cos_weight[m]),
+                        )
+                    }
                 };
                 out[cell as usize - first] = clamp_reflectance(rho);
             }

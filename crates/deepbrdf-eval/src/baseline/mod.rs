@@ -9,7 +9,7 @@ pub use domain::Domain;
 pub use mapping::{Mapping, MappingKind};
 
 use crate::error::{EvalError, Result};
-use crate::harness::{Codec, Method, TrainingSet};
+use crate::harness::{Codec, FoldTraining, Method};
 use crate::pca::LinearBasis;
 use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::{MerlTable, Progress};
@@ -179,7 +179,7 @@ impl Codec for BaselineCodec {
     }
 }
 
-/// PCA or IPCA as a harness [`Method`] (see [`crate::pca::Pca::method`], [`crate::ipca::Ipca::method`]).
+/// PCA or IPCA as a harness [`Method`] ([`BaselineMethod::pca`], [`BaselineMethod::ipca`]).
 #[derive(Clone, Debug)]
 pub struct BaselineMethod {
     name: String,
@@ -193,6 +193,19 @@ impl BaselineMethod {
     /// A baseline named `name` with mapping `kind`.
     pub fn new(name: &str, kind: MappingKind) -> Self {
         Self { name: name.to_string(), kind, keep_last: false, last: Arc::default() }
+    }
+
+    /// The paper's "traditional PCA" (§4): natural log of the reflectance
+    /// ([`crate::pca::log_map`]), all three channels of a BRDF in one row, mean-centred, truncated
+    /// to k components.
+    pub fn pca() -> Self {
+        Self::new("PCA", MappingKind::Log)
+    }
+
+    /// IPCA (§4, Nielsen et al. 2015): PCA after the cosine-weighted log-relative mapping
+    /// ([`crate::ipca::cosine_log_relative`]) against the training median.
+    pub fn ipca() -> Self {
+        Self::new("IPCA", MappingKind::LogRelative)
     }
 
     /// The same method, keeping the basis of its latest harness fit (to save it as an
@@ -262,7 +275,7 @@ impl Method for BaselineMethod {
     /// As [`Method::fit_ks`], reusing the fold's median reference for IPCA.
     fn fit_fold(
         &self,
-        train: &TrainingSet<'_>,
+        train: &FoldTraining<'_>,
         ks: &[usize],
         progress: &dyn Progress,
     ) -> Result<Vec<Box<dyn Codec>>> {
@@ -293,7 +306,7 @@ mod tests {
     fn max_weighted_error(a: &MerlTable, b: &MerlTable, domain: &Domain) -> f64 {
         let mut worst = 0f64;
         for &cell in domain.cells() {
-            let w = f64::from(crate::ipca::cos_weights()[cell as usize]);
+            let w = f64::from(deepbrdf_data::merl::grid::cos_weights()[cell as usize]);
             for c in 0..3 {
                 let i = c * CELLS + cell as usize;
                 worst = worst.max((f64::from(a.values()[i]) - f64::from(b.values()[i])).abs() * w);
@@ -326,7 +339,7 @@ mod tests {
     fn full_rank_codecs_reproduce_their_training_tables() {
         let (names, tables) = sparse_set(5);
         let refs: Vec<&MerlTable> = tables.iter().collect();
-        for method in [crate::pca::Pca::method(), crate::ipca::Ipca::method()] {
+        for method in [BaselineMethod::pca(), BaselineMethod::ipca()] {
             let codecs = method.fit_ks(&refs, &names, &[1, 4], &Silent).unwrap();
             assert_eq!(codecs[1].name(), format!("{}-4", method.name()));
             let domain = Domain::common(&refs).unwrap();
@@ -348,7 +361,7 @@ mod tests {
         let (names, tables) = sparse_set(4);
         let refs: Vec<&MerlTable> = tables.iter().collect();
         let dir = tempfile::tempdir().unwrap();
-        for method in [crate::pca::Pca::method(), crate::ipca::Ipca::method()] {
+        for method in [BaselineMethod::pca(), BaselineMethod::ipca()] {
             // The basis a harness fit keeps is the one saved (as `experiments baselines
             // --save-basis` does).
             let method = method.keeping_last_fit();

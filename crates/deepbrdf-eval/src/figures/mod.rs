@@ -1,4 +1,4 @@
 //! Figures of results: line charts (error vs k, per-material error) as SVG and PNG.
 mod plots;
 
-pub use plots::{write_atomic_file, write_chart, write_panels, LineChart, Series};
+pub use plots::{write_chart, write_panels, LineChart, Series};

@@ -3,6 +3,7 @@
 //! figures render identically with no system fonts installed.
 
 use crate::error::{EvalError, Result};
+use deepbrdf_data::files::write_atomic;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::FontTransform;
@@ -74,7 +75,7 @@ pub fn write_panels(charts: &[LineChart], stem: &Path) -> Result<()> {
             .map_err(|e| EvalError::Invalid(format!("{}: {e}", svg_path.display())))?;
         root.present().map_err(|e| EvalError::Invalid(format!("{}: {e}", svg_path.display())))?;
     }
-    write_atomic_file(&svg_path, svg.as_bytes())?;
+    write_atomic(&svg_path, svg.as_bytes())?;
 
     let png_path = with_ext(stem, "png");
     let mut buf = vec![255u8; (w * h * 3) as usize];
@@ -89,7 +90,7 @@ pub fn write_panels(charts: &[LineChart], stem: &Path) -> Result<()> {
     let mut png = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
         .map_err(|e| EvalError::Invalid(format!("{}: {e}", png_path.display())))?;
-    write_atomic_file(&png_path, &png)
+    Ok(write_atomic(&png_path, &png)?)
 }
 
 /// Draws each chart in its own horizontal band of `root`, top to bottom.
@@ -116,18 +117,6 @@ fn with_ext(stem: &Path, ext: &str) -> PathBuf {
     s.push(".");
     s.push(ext);
     PathBuf::from(s)
-}
-
-/// Writes `bytes` to `path` through a temporary file in the same directory and a rename.
-pub fn write_atomic_file(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tmp"));
-    std::fs::write(&tmp, bytes).map_err(|e| EvalError::io(&tmp, e))?;
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        EvalError::io(path, e)
-    })
 }
 
 /// Distinct, print-friendly line colours.

@@ -8,7 +8,7 @@ use deepbrdf_data::{MerlTable, Progress};
 
 /// The training side of one fold as the harness hands it to a [`Method`].
 #[derive(Clone, Copy)]
-pub struct TrainingSet<'a> {
+pub struct FoldTraining<'a> {
     pub tables: &'a [&'a MerlTable],
     /// `names[i]` names `tables[i]`.
     pub names: &'a [String],
@@ -60,7 +60,7 @@ pub trait Method: Sync {
     /// The default ignores the precomputed reference and calls [`Method::fit_ks`].
     fn fit_fold(
         &self,
-        train: &TrainingSet<'_>,
+        train: &FoldTraining<'_>,
         ks: &[usize],
         progress: &dyn Progress,
     ) -> Result<Vec<Box<dyn Codec>>> {

@@ -2,9 +2,8 @@
 //! in the original only (invalid cells carry no measurement).
 
 use crate::error::{EvalError, Result};
-use crate::ipca;
 use deepbrdf_data::mapping::{log_relative, MedianReference};
-use deepbrdf_data::merl::{CELLS, VALUES};
+use deepbrdf_data::merl::{grid, CELLS, VALUES};
 use deepbrdf_data::MerlTable;
 use rayon::prelude::*;
 use std::fmt;
@@ -73,7 +72,7 @@ impl FromStr for Measure {
 }
 
 /// What the measures compare against: the training median of eq. (1) (and the grid's cosine
-/// weights, [`ipca::cos_weights`]).
+/// weights, [`grid::cos_weights`]).
 pub struct Yardstick {
     reference: MedianReference,
 }
@@ -150,9 +149,11 @@ impl Yardstick {
         }
         let want_mapped = measures.contains(&Measure::MappedMse);
         let (a, b, r) = (original.table.values(), recon.values(), self.reference.values());
-        let weights = ipca::cos_weights();
-        // Sums of squared eq. (1) differences and of squared cosine-weighted differences.
-        let (mapped_sum, cos_sum) = original
+        let weights = grid::cos_weights();
+        // Sums of squared eq. (1) differences and of squared cosine-weighted differences: one
+        // partial sum per chunk in parallel, added in chunk order (the same bits for any thread
+        // count).
+        let parts: Vec<(f64, f64)> = original
             .cells
             .par_chunks(CHUNK)
             .enumerate()
@@ -175,7 +176,8 @@ impl Yardstick {
                 }
                 (mapped_sum, cos_sum)
             })
-            .reduce(|| (0.0, 0.0), |x, y| (x.0 + y.0, x.1 + y.1));
+            .collect();
+        let (mapped_sum, cos_sum) = parts.iter().fold((0.0, 0.0), |x, y| (x.0 + y.0, x.1 + y.1));
         let count = (3 * n) as f64;
         Ok(measures
             .iter()
@@ -217,7 +219,7 @@ mod tests {
         let mb = yardstick.reference().map(&MerlTable::from_values(zeroed.clone()).unwrap());
         let (mut mse, mut cos, mut count) = (0f64, 0f64, 0usize);
         for cell in (0..CELLS).filter(|&c| a.is_valid(c)) {
-            let w = ipca::cos_product(cell);
+            let w = grid::cos_product(cell);
             for c in 0..3 {
                 let i = c * CELLS + cell;
                 mse += (f64::from(ma[i]) - f64::from(mb[i])).powi(2);

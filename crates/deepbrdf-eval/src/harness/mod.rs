@@ -7,7 +7,7 @@ mod measures;
 mod modes;
 mod report;
 
-pub use codec::{Codec, Method, TrainingSet};
+pub use codec::{Codec, FoldTraining, Method};
 pub use deepbrdf_data::mapping::MedianReference;
 pub use measures::{Measure, Original, Yardstick};
 pub use modes::{Fold, Mode};
@@ -139,7 +139,7 @@ pub fn run(
         for method in methods {
             let t = Instant::now();
             let set =
-                TrainingSet { tables: &tables, names: &names, reference: yardstick.reference() };
+                FoldTraining { tables: &tables, names: &names, reference: yardstick.reference() };
             let fitted = method.fit_fold(&set, &config.ks, progress)?;
             if fitted.len() != config.ks.len()
                 || fitted.iter().zip(&config.ks).any(|(c, &k)| c.k() != k)
@@ -226,7 +226,7 @@ mod tests {
     use std::sync::Mutex;
 
     fn methods() -> (BaselineMethod, BaselineMethod) {
-        (crate::pca::Pca::method(), crate::ipca::Ipca::method())
+        (crate::baseline::BaselineMethod::pca(), crate::baseline::BaselineMethod::ipca())
     }
 
     #[test]

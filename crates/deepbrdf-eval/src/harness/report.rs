@@ -177,7 +177,7 @@ impl Results {
                 r.value
             );
         }
-        crate::figures::write_atomic_file(&dir.join("results.csv"), csv.as_bytes())?;
+        deepbrdf_data::files::write_atomic(&dir.join("results.csv"), csv.as_bytes())?;
         let mut fits = String::from("method,fold,n_train,seconds\n");
         for f in &self.fits {
             let _ = writeln!(
@@ -189,8 +189,8 @@ impl Results {
                 f.seconds
             );
         }
-        crate::figures::write_atomic_file(&dir.join("fits.csv"), fits.as_bytes())?;
-        crate::figures::write_atomic_file(
+        deepbrdf_data::files::write_atomic(&dir.join("fits.csv"), fits.as_bytes())?;
+        deepbrdf_data::files::write_atomic(
             &dir.join("summary.md"),
             self.summary_markdown().as_bytes(),
         )?;

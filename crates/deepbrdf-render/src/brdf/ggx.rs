@@ -1,6 +1,7 @@
 //! A GGX microfacet reflection lobe with Schlick's Fresnel (Walter et al., "Microfacet models
 //! for refraction through rough surfaces", EGSR 2007; Schlick 1994):
-//! `f = D(h) G(wi, wo) F(wi.h) / (4 cos(theta_i) cos(theta_o))`.
+//! `f = D(h) G(wi, wo) F(wi.h) / (4 cos(theta_i) cos(theta_o))`, evaluated by the workspace's one
+//! GGX formula ([`deepbrdf_data::ggx`]); this file adds importance sampling.
 
 use super::{Brdf, Rgb};
 use crate::geometry::Vec3;
@@ -19,24 +20,11 @@ impl Ggx {
         Self { alpha: alpha.clamp(1e-4, 1.0), f0 }
     }
 
-    /// GGX normal distribution `D(h) = alpha^2 / (pi ((alpha^2 - 1) cos^2 + 1)^2)`
-    /// (Walter et al. 2007, eq. 33), normalised so that `integral D cos(theta_h) dw = 1`.
+    /// GGX normal distribution `D(h)` ([`deepbrdf_data::ggx::distribution`], Walter et al.
+    /// 2007, eq. 33), normalised so that `integral D cos(theta_h) dw = 1`.
     #[inline]
     pub fn distribution(alpha: f64, cos_h: f64) -> f64 {
-        if cos_h <= 0.0 {
-            return 0.0;
-        }
-        let a2 = alpha * alpha;
-        let d = (a2 - 1.0) * cos_h * cos_h + 1.0;
-        a2 / (PI * d * d)
-    }
-
-    /// Smith's masking for GGX, `G1(v) = 2 cos / (cos + sqrt(alpha^2 + (1 - alpha^2) cos^2))`
-    /// (Walter et al. 2007, eq. 34).
-    #[inline]
-    fn smith_g1(alpha: f64, cos: f64) -> f64 {
-        let a2 = alpha * alpha;
-        2.0 * cos / (cos + (a2 + (1.0 - a2) * cos * cos).sqrt())
+        deepbrdf_data::ggx::distribution(alpha, cos_h)
     }
 
     /// A half vector drawn with density `D(h) cos(theta_h)` (Walter et al. 2007, eqs. 35-36).
@@ -64,16 +52,8 @@ impl Ggx {
 
 impl Brdf for Ggx {
     fn eval(&self, wi: Vec3, wo: Vec3) -> Rgb {
-        if wi.z <= 0.0 || wo.z <= 0.0 {
-            return [0.0; 3];
-        }
-        let h = (wi + wo).normalized();
-        let d = Self::distribution(self.alpha, h.z);
-        let g = Self::smith_g1(self.alpha, wi.z) * Self::smith_g1(self.alpha, wo.z);
-        let c = wi.dot(h).clamp(0.0, 1.0);
-        let schlick = (1.0 - c).powi(5);
-        let common = d * g / (4.0 * wi.z * wo.z);
-        self.f0.map(|f0| (f0 + (1.0 - f0) * schlick) * common)
+        let lobe = deepbrdf_data::ggx::Ggx { alpha: self.alpha, f0: self.f0, diffuse: [0.0; 3] };
+        deepbrdf_data::ggx::ggx(&lobe, wi.to_array(), wo.to_array())
     }
 
     fn sample(&self, wo: Vec3, u: [f64; 2]) -> Option<Vec3> {
@@ -94,21 +74,6 @@ impl Brdf for Ggx {
 mod tests {
     use super::*;
     use crate::brdf::tests::check_sampling;
-
-    #[test]
-    fn distribution_is_normalised() {
-        // integral over the hemisphere of D(h) cos(theta_h) = 1 (midpoint rule in theta).
-        for alpha in [0.05, 0.3, 0.8] {
-            let n = 200_000;
-            let mut sum = 0.0;
-            for i in 0..n {
-                let t = (i as f64 + 0.5) / n as f64 * PI / 2.0;
-                sum += Ggx::distribution(alpha, t.cos()) * t.cos() * t.sin();
-            }
-            let integral = sum * 2.0 * PI * (PI / 2.0) / n as f64;
-            assert!((integral - 1.0).abs() < 1e-3, "alpha {alpha}: {integral}");
-        }
-    }
 
     #[test]
     fn reciprocal_and_below_horizon_zero() {

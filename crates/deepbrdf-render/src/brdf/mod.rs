@@ -12,13 +12,15 @@ mod lambertian;
 mod lobe;
 mod merl;
 mod sum;
+mod table_sampler;
 
 pub use ggx::Ggx;
 pub use interleaved::InterleavedTable;
 pub use lambertian::Lambertian;
 pub use lobe::SamplingLobe;
-pub use merl::{MerlBrdf, MerlLookup};
+pub use merl::{MerlBrdf, MerlLookup, MerlSampling};
 pub use sum::Sum;
+pub use table_sampler::TableSampler;
 
 use super::geometry::Vec3;
 use std::f64::consts::{FRAC_1_PI, PI};

@@ -8,8 +8,6 @@ use deepbrdf_data::dataset::{DataSource, Dataset};
 use deepbrdf_data::Progress;
 use deepbrdf_eval::baseline::BaselineMethod;
 use deepbrdf_eval::harness::{self, HarnessConfig, Materials, Measure, Method, Mode};
-use deepbrdf_eval::ipca::Ipca;
-use deepbrdf_eval::pca::Pca;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -72,9 +70,11 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         bail!("--eval-collections is for generalize mode only");
     }
     let out = args.out.clone().unwrap_or_else(|| default_out(args.mode));
+    // Held until the run ends: a second run on the same folder is refused (issue 15).
+    let _lock = deepbrdf_data::lock::FolderLock::acquire(&out)?;
     // Refuse before any work, so a long run never ends by refusing to write.
     check_not_overwriting(&out, &RESULT_FILES, args.force, "results of an earlier run")?;
-    let (pca, ipca) = (Pca::method(), Ipca::method());
+    let (pca, ipca) = (BaselineMethod::pca(), BaselineMethod::ipca());
     let (pca, ipca) = match &args.save_basis {
         Some(dir) => {
             let names = [format!("{}.basis", pca.name()), format!("{}.basis", ipca.name())];

@@ -45,36 +45,30 @@ pub struct Args {
 }
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
-    let scene_config = args.scene.scene()?;
-    let settings = args.scene.settings(256);
-    let tonemap = args.scene.tonemap()?;
+    let setup = args.scene.setup(256)?;
     let cache = args.cache.cache();
     let (name_a, a) =
         load_material(&args.a, &cache).with_context(|| format!("loading material '{}'", args.a))?;
     let (name_b, b) =
         load_material(&args.b, &cache).with_context(|| format!("loading material '{}'", args.b))?;
-    let scene = scene_config.build()?;
-    // Both rendered with A's sampling proxy and the same seed: the same directions are drawn, so
-    // the difference is the materials', not Monte Carlo noise.
+    // Both rendered with A's sampling and the same seed: the same directions are drawn, so the
+    // difference is the materials', not Monte Carlo noise.
     let brdf_a = MerlBrdf::new(&a);
-    let image_a = render(&scene, &brdf_a, &settings, progress)?;
+    let image_a = render(&setup.scene, &brdf_a, &setup.settings, progress)?;
     let image_b = if args.evaluator {
         let measured = load_evaluator(&args.b)?;
-        let brdf = MeasuredBrdf { brdf: &measured, lobe: brdf_a.lobe() };
-        render(&scene, &brdf, &settings, progress)?
+        let brdf = MeasuredBrdf { brdf: &measured, sampler: &brdf_a };
+        render(&setup.scene, &brdf, &setup.settings, progress)?
     } else {
-        render(&scene, &MerlBrdf::new(&b).with_lobe(brdf_a.lobe()), &settings, progress)?
+        let brdf_b = MerlBrdf::new_sampled(&b, brdf_a.sampling().clone());
+        render(&setup.scene, &brdf_b, &setup.settings, progress)?
     };
     let name_b = if args.evaluator { format!("{name_b} (evaluator)") } else { name_b };
-    let c = compare_images(&image_b, &image_a, &tonemap)?;
+    let c = compare_images(&image_b, &image_a, &setup.tonemap)?;
     difference_image(&image_b, &image_a, args.scale)?.write_png(&args.output)?;
     println!(
-        "{name_b} vs {name_a} ({}x{} {} on a {}, {} spp): RelAE {:.4}  RMSE {:.4}  PSNR {:.2} dB -> {}",
-        settings.size,
-        settings.size,
-        scene_config.light,
-        scene_config.shape,
-        settings.spp,
+        "{name_b} vs {name_a} ({}): RelAE {:.4}  RMSE {:.4}  PSNR {:.2} dB -> {}",
+        setup.description(),
         c.relae,
         c.rmse,
         c.psnr,

@@ -4,7 +4,7 @@
 //! JSON (sorted, no timestamps), so re-packing the same folder gives identical files.
 use anyhow::Context;
 use deepbrdf_data::bundled::Collection;
-use deepbrdf_data::cache::write_atomically;
+use deepbrdf_data::files::create_parent_and_write;
 use deepbrdf_data::nbrdf::{pack, read_json_folder};
 use deepbrdf_data::Progress;
 use sha2::{Digest, Sha256};
@@ -31,7 +31,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         let path = args.out.join(collection.pack_file_name());
         let unchanged = std::fs::read(&path).is_ok_and(|old| old == bytes);
         if !unchanged {
-            write_atomically(&path, &bytes)?;
+            create_parent_and_write(&path, &bytes)?;
         }
         println!(
             "{:12} {:4} networks {:8} bytes  sha256 {}  {}{}",

@@ -26,27 +26,20 @@ pub struct Args {
 }
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
-    let scene_config = args.scene.scene()?;
-    let settings = args.scene.settings(256);
-    let tonemap = args.scene.tonemap()?;
+    let setup = args.scene.setup(256)?;
     let (name, table) = load_material(&args.material, &args.cache.cache())
         .with_context(|| format!("loading material '{}'", args.material))?;
-    let scene = scene_config.build()?;
     let start = Instant::now();
-    let image = render(&scene, &MerlBrdf::new(&table), &settings, progress)?;
+    let image = render(&setup.scene, &MerlBrdf::new(&table), &setup.settings, progress)?;
     let seconds = start.elapsed().as_secs_f64();
-    image.write_png(&args.output, &tonemap)?;
+    image.write_png(&args.output, &setup.tonemap)?;
     if let Some(exr) = &args.exr {
         image.write_exr(exr)?;
     }
     println!(
-        "{name}: {}x{} {} on a {}, {} spp, seed {}, rendered in {seconds:.2} s -> {}{}",
-        settings.size,
-        settings.size,
-        scene_config.light,
-        scene_config.shape,
-        settings.spp,
-        settings.seed,
+        "{name}: {}, seed {}, rendered in {seconds:.2} s -> {}{}",
+        setup.description(),
+        setup.settings.seed,
         args.output.display(),
         args.exr.as_ref().map(|p| format!(", {}", p.display())).unwrap_or_default()
     );

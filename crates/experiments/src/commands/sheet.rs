@@ -26,17 +26,15 @@ pub struct Args {
 }
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
-    let scene_config = args.scene.scene()?;
-    let settings = args.scene.settings(128);
-    let tonemap = args.scene.tonemap()?;
+    let setup = args.scene.setup(128)?;
     let dataset = args.data.load(progress)?;
-    let scene = scene_config.build()?;
     let start = Instant::now();
     progress.start(dataset.tables.len() as u64, "sheet");
     let mut tiles = Vec::with_capacity(dataset.tables.len());
     for (name, table) in dataset.names.iter().zip(&dataset.tables) {
-        let image = render(&scene, &MerlBrdf::new(table), &settings, &Silent)?;
-        tiles.push(Tile { image: image.to_srgb8(&tonemap, BACKGROUND), caption: name.clone() });
+        let image = render(&setup.scene, &MerlBrdf::new(table), &setup.settings, &Silent)?;
+        let image = image.to_srgb8(&setup.tonemap, BACKGROUND);
+        tiles.push(Tile { image, caption: name.clone() });
         progress.advance(1);
     }
     progress.finish();
@@ -49,11 +47,11 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         "{} materials of {} ({}x{} each, {} on a {}, {} spp) rendered in {:.1} s -> {}",
         tiles.len(),
         dataset.label,
-        settings.size,
-        settings.size,
-        scene_config.light,
-        scene_config.shape,
-        settings.spp,
+        setup.settings.size,
+        setup.settings.size,
+        setup.config.light,
+        setup.config.shape,
+        setup.settings.spp,
         start.elapsed().as_secs_f64(),
         args.output.display()
     );

@@ -14,8 +14,8 @@ use crate::robustness::{self, Robustness, NEAREST_FILL};
 use crate::slices_figure::{self, FIG2_MATERIAL};
 use anyhow::{bail, Context};
 use deepbrdf_data::dataset::Dataset;
+use deepbrdf_data::files::write_atomic;
 use deepbrdf_data::Progress;
-use deepbrdf_eval::figures::write_atomic_file;
 use deepbrdf_eval::harness::{self, HarnessConfig, Materials, Measure, Mode, Results};
 use deepbrdf_model::burn::config::Config as _;
 use deepbrdf_model::{Preset, TrainConfig};
@@ -166,7 +166,8 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
     let kind = crate::device_arg::kind()?;
     let device = crate::device_arg::device()?;
     let out = args.out_dir();
-    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    // Held until the sweep ends: a second run on the same folder is refused (issue 15).
+    let _lock = deepbrdf_data::lock::FolderLock::acquire(&out)?;
     let models_dir = out.join("models");
 
     let data = args.load_data(progress)?;
@@ -229,7 +230,7 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
         loaded_at,
         wall,
     };
-    write_atomic_file(&out.join("summary.md"), report.summary_markdown().as_bytes())?;
+    write_atomic(&out.join("summary.md"), report.summary_markdown().as_bytes())?;
     if let Some(readme) = &args.update_readme {
         let block = report.readme_block(readme, &out)?;
         readme_block::update_file(readme, README_BEGIN, README_END, &block)?;
@@ -277,7 +278,7 @@ fn write_training_csv(fits: &[FitRecord], out: &Path) -> anyhow::Result<()> {
             f.dir.display()
         );
     }
-    write_atomic_file(&out.join("training.csv"), csv.as_bytes())?;
+    write_atomic(&out.join("training.csv"), csv.as_bytes())?;
     Ok(())
 }
 

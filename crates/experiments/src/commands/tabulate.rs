@@ -2,7 +2,7 @@
 //! (a whole collection, or one material), through the table cache. An existing file with other
 //! content is never overwritten without `--force`; identical files are left as they are.
 use crate::data_args::CacheArg;
-use anyhow::{bail, Context};
+use anyhow::bail;
 use deepbrdf_data::bundled::{find_material, Collection};
 use deepbrdf_data::merl::io::{write_merl, MerlFile};
 use deepbrdf_data::nbrdf::Network;
@@ -45,8 +45,8 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     if args.out.exists() && !args.out.is_dir() {
         bail!("{}: exists and is not a directory", args.out.display());
     }
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
+    // Creates the folder; held until the end: a second run on the same folder is refused.
+    let _lock = deepbrdf_data::lock::FolderLock::acquire(&args.out)?;
     let cache = args.cache.cache();
     let start = Instant::now();
     let label = args.material.clone().unwrap_or_else(|| args.collection.to_string());

@@ -7,6 +7,7 @@
 //! per epoch.
 use crate::data_args::DataArgs;
 use anyhow::{bail, Context};
+use deepbrdf_data::lock::FolderLock;
 use deepbrdf_data::Progress;
 use deepbrdf_model::burn::config::Config;
 use deepbrdf_model::train::{checkpoint_path, saved_config};
@@ -100,12 +101,15 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let device = crate::device_arg::device()?;
     let kind = crate::device_arg::kind()?;
     let resume_dir = args.resume.clone().map(|d| d.or_else(|| args.out.clone()));
+    // Held until the run ends: a second run on the same folder is refused (issue 15).
+    let lock: FolderLock;
     let (out, config, resume) = match resume_dir {
         Some(None) => bail!("--resume needs a directory (--resume DIR or --out DIR --resume)"),
         Some(Some(dir)) => {
             if !checkpoint_path(&dir).is_file() {
                 bail!("{}: no interrupted run to resume (no checkpoint.bin)", dir.display());
             }
+            lock = FolderLock::acquire(&dir)?;
             let config = saved_config(&dir)?;
             eprintln!(
                 "resuming {} (k = {}, {} epochs, batch {}, lr {:e})",
@@ -119,6 +123,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         }
         None => {
             let out = args.out.clone().context("--out DIR is required")?;
+            lock = FolderLock::acquire(&out)?;
             if checkpoint_path(&out).exists() {
                 bail!(
                     "{} already holds a training run; continue it with --resume {} or choose \
@@ -151,5 +156,6 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         p.materials.len()
     );
     println!("model {} written to {}", model.id(), out.join("model").display());
+    drop(lock);
     Ok(())
 }

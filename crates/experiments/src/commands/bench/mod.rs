@@ -7,6 +7,7 @@ pub mod io;
 pub mod lookup;
 pub mod model;
 pub mod render;
+pub mod render_noise;
 pub mod tabulate;
 
 #[derive(Debug, clap::Args)]
@@ -33,6 +34,9 @@ pub enum What {
     /// Renderer speed: MERL lookups per second and images per second (target: a 256x256 sphere
     /// of a tabulated MERL material under sun and sky at 64 spp in < 0.5 s on 2 cores).
     Render(render::Args),
+    /// Renderer efficiency at equal noise: seconds per image, relative noise between two seeds
+    /// and 1 / (noise^2 x s), per material and light (issue 16).
+    RenderNoise(render_noise::Args),
 }
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
@@ -43,5 +47,6 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         What::Model(a) => model::run(a, progress),
         What::Render(a) => render::run(a, progress),
         What::Convert(a) => convert::run(a, progress),
+        What::RenderNoise(a) => render_noise::run(a, progress),
     }
 }

@@ -1,0 +1,320 @@
+//! The autoencoder's configuration: the latent dimension k, the leaky ReLU slope and one
+//! [`Architecture`] (Table 1's convolutional network or the `cpu` preset's spectral one), with
+//! the two presets and the checks that keep [`AutoencoderConfig::init`] from building a
+//! degenerate network.
+
+use burn::config::Config;
+use burn::nn::Initializer;
+use burn::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::convolutional::Convolutional;
+use super::legacy;
+use super::spectral_network::SpectralNetwork;
+use super::Autoencoder;
+use crate::error::ModelError;
+
+/// K of the `cpu` preset's spectral path: 96 principal directions of the training set (100
+/// materials span 99; with 48 the 51 left out still carried 6e-4 of mapped-space MSE, above what
+/// nearest-slice filling loses from 1/9 of the slices). The basis is stored in the model:
+/// 96 x 4.37 M values, 1.7 GB in f32 while training, 0.67 GB as saved ([`crate::compact`]).
+pub const CPU_SPECTRAL_BASIS: usize = 96;
+/// Width of the `cpu` preset's coefficient-space MLPs.
+pub const CPU_SPECTRAL_HIDDEN: usize = 256;
+
+/// Architecture of the autoencoder: k ([`latent`](Self::latent)) is the FC-10 of Table 1.
+///
+/// Serialised as `{"latent": k, "negative_slope": s, "architecture": {...}}`; the flat format
+/// of earlier versions (a `convolutional` flag and optional spectral fields) still parses
+/// (see [`super::legacy`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "serde_json::Value")]
+pub struct AutoencoderConfig {
+    /// k, the dimension of the latent vector (Table 1's FC-10; §3.2 studies 5 to 40).
+    pub latent: usize,
+    /// Negative slope of the leaky ReLUs (PyTorch's default, as the paper does not say).
+    pub negative_slope: f64,
+    /// Which network maps a BRDF to its k latent values and back.
+    pub architecture: Architecture,
+}
+
+impl Config for AutoencoderConfig {}
+
+impl std::fmt::Display for AutoencoderConfig {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&burn::config::config_to_json(self))
+    }
+}
+
+/// The networks an autoencoder can be. New ones (say, a network for a new input layout) are new
+/// variants here and in [`Autoencoder`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Architecture {
+    /// Table 1's convolutional encoder and decoder (and narrower variants of it).
+    Convolutional(ConvolutionalConfig),
+    /// The `cpu` preset: MLPs on the coordinates in the training set's principal directions
+    /// ([`crate::spectral`]), around the fixed training mean.
+    Spectral(SpectralConfig),
+}
+
+/// The layers of Table 1's convolutional network.
+#[derive(Config, Debug, PartialEq)]
+pub struct ConvolutionalConfig {
+    /// Width C of a per-pixel 1x1 projection 540 -> C applied first (and C -> 540 applied
+    /// last); `None` in Table 1, where the strided convolutions see all 540 channels.
+    #[config(default = "None")]
+    pub projection: Option<usize>,
+    /// Output channels of the three 3x3 stride-2 convolutions (Table 1: 256, 128, 64).
+    #[config(default = "[256, 128, 64]")]
+    pub encoder_channels: [usize; 3],
+    /// Number of residual blocks at the bottleneck (Table 1: 3).
+    #[config(default = 3)]
+    pub residual_blocks: usize,
+    /// Output channels of the first two deconvolutions (Table 1: 128 at 24 x 24, 256 at 48 x 48).
+    #[config(default = "[128, 256]")]
+    pub decoder_channels: [usize; 2],
+    /// Predict deviations from a fixed per-value offset (the training mean in mapped space,
+    /// set with [`Autoencoder::with_offset`]); the input is centred on it too. Not in Table 1.
+    #[config(default = false)]
+    pub mean_offset: bool,
+    /// He initialisation (normal, gain sqrt(2) for the leaky ReLUs, the residual blocks'
+    /// second convolutions at zero so they start as identities) instead of PyTorch's default
+    /// (uniform, gain 1/sqrt(3)), under which activations shrink layer after layer and the
+    /// latent vector starts near zero. Not a Table 1 setting; training converges much faster.
+    #[config(default = false)]
+    pub he_init: bool,
+}
+
+/// The spectral network of the `cpu` preset (not in the paper, see [`crate::spectral`]).
+#[derive(Config, Debug, PartialEq)]
+pub struct SpectralConfig {
+    /// K, the leading principal directions of the training set the network works on, K >= k
+    /// (set with [`Autoencoder::with_basis`]).
+    pub directions: usize,
+    /// Width of the two coefficient-space MLPs (none: a purely linear path, PCA).
+    #[config(default = "None")]
+    pub hidden: Option<usize>,
+    /// He initialisation of the MLPs' hidden layers (as [`ConvolutionalConfig::he_init`]).
+    #[config(default = false)]
+    pub he_init: bool,
+}
+
+/// Largest layer width, latent dimension or basis size accepted (a guard against typos that
+/// would allocate terabytes).
+const MAX_WIDTH: usize = 4096;
+
+impl AutoencoderConfig {
+    /// A network of `architecture` with latent dimension `k` and PyTorch's leaky ReLU slope.
+    pub fn new(k: usize, architecture: Architecture) -> Self {
+        Self { latent: k, negative_slope: 0.01, architecture }
+    }
+
+    /// Table 1 exactly, with latent dimension `k`.
+    pub fn paper(k: usize) -> Self {
+        Self::convolutional(k, ConvolutionalConfig::new())
+    }
+
+    /// A convolutional network of latent dimension `k`.
+    pub fn convolutional(k: usize, layers: ConvolutionalConfig) -> Self {
+        Self::new(k, Architecture::Convolutional(layers))
+    }
+
+    /// The CPU preset: the autoencoder on spectral coordinates ([`crate::spectral`]): the
+    /// input projected on the training set's [`CPU_SPECTRAL_BASIS`] leading principal
+    /// directions (eq. (1) space, centred on the training mean), MLP encoder and decoder of
+    /// width [`CPU_SPECTRAL_HIDDEN`] to and from k (He initialisation), output expanded back to
+    /// 540 x 90 x 90. Not Table 1: on a 2-core CPU the convolutional network cannot leave the
+    /// training mean within the 30-minute budget of `sweep-k` (measured: 18 epochs of a narrow
+    /// variant, 2.5 min, mapped MSE 0.061 against PCA's 0.011 at k = 10), while this trains
+    /// 1000 epochs in seconds.
+    pub fn cpu(k: usize) -> Self {
+        Self::new(
+            k,
+            Architecture::Spectral(
+                SpectralConfig::new(CPU_SPECTRAL_BASIS)
+                    .with_hidden(Some(CPU_SPECTRAL_HIDDEN))
+                    .with_he_init(true),
+            ),
+        )
+    }
+
+    /// A spectral network ([`crate::spectral`]): latent dimension `k`, `size` principal
+    /// directions, coefficient-space MLPs of width `hidden` (none: linear).
+    /// [`cpu`](Self::cpu) is one, with sizes chosen for the MERL collection.
+    pub fn spectral(k: usize, size: usize, hidden: Option<usize>) -> Self {
+        Self::new(k, Architecture::Spectral(SpectralConfig::new(size).with_hidden(hidden)))
+    }
+
+    /// The spectral network's settings, if it is one (its training runs on coordinates).
+    pub fn spectral_config(&self) -> Option<&SpectralConfig> {
+        match &self.architecture {
+            Architecture::Spectral(s) => Some(s),
+            Architecture::Convolutional(_) => None,
+        }
+    }
+
+    /// Whether the network is spectral: its training runs on coordinates alone and its saved
+    /// basis is compact ([`crate::compact`]).
+    pub fn spectral_only(&self) -> bool {
+        self.spectral_config().is_some()
+    }
+
+    /// Whether the network predicts deviations from a fixed offset (the training mean):
+    /// always for a spectral one, by [`ConvolutionalConfig::mean_offset`] for a convolutional
+    /// one.
+    pub fn mean_offset(&self) -> bool {
+        match &self.architecture {
+            Architecture::Spectral(_) => true,
+            Architecture::Convolutional(c) => c.mean_offset,
+        }
+    }
+
+    /// The initializer of hidden layers (followed by a leaky ReLU) and of linear outputs.
+    pub(super) fn initializers(&self, he_init: bool) -> (Initializer, Initializer) {
+        if he_init {
+            let slope = self.negative_slope;
+            let gain = (2.0 / (1.0 + slope * slope)).sqrt();
+            (
+                Initializer::KaimingNormal { gain, fan_out_only: false },
+                Initializer::KaimingNormal { gain: 1.0, fan_out_only: false },
+            )
+        } else {
+            let default =
+                Initializer::KaimingUniform { gain: 1.0 / 3f64.sqrt(), fan_out_only: false };
+            (default.clone(), default)
+        }
+    }
+
+    /// Checks the sizes once, so [`init`](Self::init) cannot build a degenerate network.
+    pub fn validate(&self) -> crate::error::Result<()> {
+        if self.latent == 0 || self.latent > MAX_WIDTH {
+            return Err(ModelError::Invalid(format!(
+                "latent dimension k = {} is out of range (1 to {MAX_WIDTH})",
+                self.latent
+            )));
+        }
+        if !self.negative_slope.is_finite() {
+            return Err(ModelError::Invalid("the leaky ReLU slope must be finite".into()));
+        }
+        match &self.architecture {
+            Architecture::Convolutional(c) => {
+                let widths = c
+                    .encoder_channels
+                    .iter()
+                    .chain(c.decoder_channels.iter())
+                    .chain(c.projection.iter());
+                if let Some(w) = widths.into_iter().find(|&&w| w == 0 || w > MAX_WIDTH) {
+                    return Err(ModelError::Invalid(format!(
+                        "a layer width of {w} is out of range (1 to {MAX_WIDTH})"
+                    )));
+                }
+                if c.residual_blocks > 64 {
+                    return Err(ModelError::Invalid(format!(
+                        "{} residual blocks is out of range (0 to 64)",
+                        c.residual_blocks
+                    )));
+                }
+            }
+            Architecture::Spectral(s) => {
+                if s.directions < self.latent || s.directions > MAX_WIDTH {
+                    return Err(ModelError::Invalid(format!(
+                        "a spectral basis of {} directions for k = {} (need k to {MAX_WIDTH})",
+                        s.directions, self.latent
+                    )));
+                }
+                if s.hidden.is_some_and(|h| h == 0 || h > MAX_WIDTH) {
+                    return Err(ModelError::Invalid(format!(
+                        "a spectral MLP width of {:?} is out of range (1 to {MAX_WIDTH})",
+                        s.hidden
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// [`init`](Self::init) with the weights drawn from `seed`, reproducibly.
+    ///
+    /// Seeding and drawing happen under one process-wide lock ([`crate::seeded`]): Burn's
+    /// generator is shared by the whole process.
+    pub fn init_seeded(&self, seed: u64, device: &Device) -> crate::error::Result<Autoencoder> {
+        crate::seeded::with_seed(seed, device, || self.build(device, true))
+    }
+
+    /// Builds the network on `device` with freshly initialised weights (and a zero offset),
+    /// drawn from the device's generator as it stands (under the lock of [`crate::seeded`]).
+    pub fn init(&self, device: &Device) -> crate::error::Result<Autoencoder> {
+        crate::seeded::exclusive(|| self.build(device, true))
+    }
+
+    /// [`init`](Self::init) without the spectral path's basis (`K x 540 x 90 x 90` values),
+    /// for loading the weights of a model whose basis is stored apart ([`crate::compact`]).
+    pub(crate) fn init_without_basis(&self, device: &Device) -> crate::error::Result<Autoencoder> {
+        crate::seeded::exclusive(|| self.build(device, false))
+    }
+
+    fn build(&self, device: &Device, allocate_basis: bool) -> crate::error::Result<Autoencoder> {
+        self.validate()?;
+        let model = match &self.architecture {
+            Architecture::Convolutional(c) => {
+                Autoencoder::Convolutional(Convolutional::new(self, c, device))
+            }
+            Architecture::Spectral(s) => {
+                Autoencoder::Spectral(SpectralNetwork::new(self, s, allocate_basis, device))
+            }
+        };
+        // Burn initialises parameters lazily, on first use, from the device's random generator;
+        // drawing them all now, in a fixed order, keeps a seeded run reproducible even when the
+        // first use happens in parallel training shards.
+        let _ = model.clone().into_record();
+        Ok(model)
+    }
+}
+
+impl TryFrom<serde_json::Value> for AutoencoderConfig {
+    type Error = String;
+
+    /// The current format, or the flat one of earlier versions ([`legacy`]).
+    fn try_from(value: serde_json::Value) -> Result<Self, String> {
+        if legacy::is_legacy(&value) {
+            return legacy::upgrade(value);
+        }
+        #[derive(Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct Current {
+            latent: usize,
+            #[serde(default = "default_slope")]
+            negative_slope: f64,
+            architecture: Architecture,
+        }
+        fn default_slope() -> f64 {
+            0.01
+        }
+        let c: Current = serde_json::from_value(value.clone()).map_err(|e| e.to_string())?;
+        let config = Self {
+            latent: c.latent,
+            negative_slope: c.negative_slope,
+            architecture: c.architecture,
+        };
+        // A misspelt optional field would otherwise be dropped silently (and its default used).
+        let written = serde_json::to_value(&config).map_err(|e| e.to_string())?;
+        match unknown_field(&value, &written) {
+            Some(field) => Err(format!("unknown field `{field}`")),
+            None => Ok(config),
+        }
+    }
+}
+
+/// The first key of `input` (as a dotted path) that `written`, the parsed value written again,
+/// lacks: a field the format does not know.
+fn unknown_field(input: &serde_json::Value, written: &serde_json::Value) -> Option<String> {
+    let (serde_json::Value::Object(input), serde_json::Value::Object(written)) = (input, written)
+    else {
+        return None;
+    };
+    input.iter().find_map(|(key, value)| match written.get(key) {
+        None => Some(key.clone()),
+        Some(w) => unknown_field(value, w).map(|inner| format!("{key}.{inner}")),
+    })
+}

@@ -1,0 +1,210 @@
+//! The DeepBRDF autoencoder (Hu et al., CGF 2020, §3.2): encoder f (eq. 2) to k latent values
+//! and decoder g (eq. 3) back, one network per [`Architecture`].
+//!
+//! The input is one BRDF in the §3.2 layout: 540 channels (phi_d x rgb) of 90 x 90 images
+//! (rows theta_h, columns theta_d), values in the eq. (1) mapped space. Invalid cells are zeroed
+//! at the input (§3.2, footnote †), so the encoder takes the validity mask with the values.
+//!
+//! - [`Autoencoder::Convolutional`] ([`convolutional`]): Table 1 exactly
+//!   ([`AutoencoderConfig::paper`]), or narrower variants of it selectable with a
+//!   configuration file, optionally around a fixed offset (the training mean).
+//! - [`Autoencoder::Spectral`] ([`spectral_network`]): the `cpu` preset
+//!   ([`AutoencoderConfig::cpu`]), not a CNN: MLPs on the coordinates of the input in the
+//!   training set's leading principal directions, around the training mean
+//!   ([`crate::spectral`]; the README says why and what it costs).
+
+mod config;
+pub mod convolutional;
+pub(crate) mod legacy;
+pub mod spectral_network;
+
+use burn::module::Param;
+use burn::prelude::*;
+use burn::tensor::TensorData;
+use deepbrdf_data::layout::{SIDE, SLICE_CHANNELS};
+use deepbrdf_data::merl::VALUES;
+
+pub use config::{
+    Architecture, AutoencoderConfig, ConvolutionalConfig, SpectralConfig, CPU_SPECTRAL_BASIS,
+    CPU_SPECTRAL_HIDDEN,
+};
+use convolutional::Convolutional;
+use spectral_network::SpectralNetwork;
+
+use crate::error::ModelError;
+use crate::spectral::SpectralPath;
+
+/// Channels of the §3.2 layout: 180 phi_d slices x 3 colour channels.
+pub const INPUT_CHANNELS: usize = SLICE_CHANNELS;
+/// Side of each layout image (90 theta_h rows x 90 theta_d columns).
+pub const INPUT_SIDE: usize = SIDE;
+/// Values of one BRDF in the layout (`540 * 90 * 90`, the MERL table's value count).
+pub const INPUT_VALUES: usize = VALUES;
+/// Side of the bottleneck images after three stride-2 convolutions (90 -> 45 -> 23 -> 12).
+pub const BOTTLENECK_SIDE: usize = 12;
+
+/// The autoencoder of §3.2, one variant per [`Architecture`].
+#[derive(Module, Debug)]
+pub enum Autoencoder {
+    /// Table 1 (and narrower variants).
+    Convolutional(Convolutional),
+    /// The `cpu` preset's network on spectral coordinates.
+    Spectral(SpectralNetwork),
+}
+
+/// A zero offset (set with [`Autoencoder::with_offset`]), not trained.
+fn zero_offset(device: &Device) -> Param<Tensor<3>> {
+    Param::from_tensor(Tensor::zeros([INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE], device))
+        .set_require_grad(false)
+}
+
+impl Autoencoder {
+    fn offset_ref(&self) -> Option<&Param<Tensor<3>>> {
+        match self {
+            Self::Convolutional(c) => c.offset.as_ref(),
+            Self::Spectral(s) => Some(&s.offset),
+        }
+    }
+
+    /// Sets the fixed output offset (the per-value training mean, 540 x 90 x 90 in layout order).
+    /// Errors if the configuration has no offset or `values` has the wrong length.
+    pub fn with_offset(self, values: &[f32]) -> crate::error::Result<Self> {
+        if values.len() != INPUT_VALUES {
+            return Err(ModelError::Invalid(format!(
+                "an offset has {INPUT_VALUES} values, got {}",
+                values.len()
+            )));
+        }
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(ModelError::Invalid(format!("offset value {i} is not finite")));
+        }
+        let data = TensorData::new(values.to_vec(), [INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE]);
+        let set = |old: Param<Tensor<3>>| {
+            old.map(|old| Tensor::from_data(data, &old.device())).set_require_grad(false)
+        };
+        match self {
+            Self::Convolutional(mut c) => {
+                let Some(old) = c.offset.take() else {
+                    return Err(ModelError::Invalid(
+                        "this configuration has no mean offset".into(),
+                    ));
+                };
+                c.offset = Some(set(old));
+                Ok(Self::Convolutional(c))
+            }
+            Self::Spectral(mut s) => {
+                s.offset = set(s.offset);
+                Ok(Self::Spectral(s))
+            }
+        }
+    }
+
+    /// Sets the spectral path's basis: K orthonormal rows of `540 * 90 * 90` values in layout
+    /// order ([`crate::principal::fit_basis`]).
+    pub fn with_basis(self, rows: &[f32]) -> crate::error::Result<Self> {
+        match self {
+            Self::Spectral(mut s) => {
+                s.spectral = s.spectral.with_basis(rows)?;
+                Ok(Self::Spectral(s))
+            }
+            Self::Convolutional(_) => {
+                Err(ModelError::Invalid("this configuration has no spectral path".into()))
+            }
+        }
+    }
+
+    /// The spectral path, if the network is spectral.
+    pub fn spectral(&self) -> Option<&SpectralPath> {
+        match self {
+            Self::Spectral(s) => Some(&s.spectral),
+            Self::Convolutional(_) => None,
+        }
+    }
+
+    /// The spectral path, mutably (for the codec to take its basis).
+    pub(crate) fn spectral_mut(&mut self) -> Option<&mut SpectralPath> {
+        match self {
+            Self::Spectral(s) => Some(&mut s.spectral),
+            Self::Convolutional(_) => None,
+        }
+    }
+
+    /// The latent dimension k.
+    pub fn latent(&self) -> usize {
+        match self {
+            Self::Convolutional(c) => c.latent,
+            Self::Spectral(s) => s.spectral.latent(),
+        }
+    }
+
+    /// Encoder f (eq. 2): the k latent values of each BRDF. Invalid cells are zeroed first.
+    ///
+    /// # Shapes
+    /// - input: `[batch, 540, 90, 90]` mapped values
+    /// - mask: `[batch, 540, 90, 90]`, 1 for valid cells, 0 for invalid ones
+    /// - output: `[batch, k]`
+    pub fn encode(&self, input: Tensor<4>, mask: Tensor<4>) -> Tensor<2> {
+        let centred = match self.offset_ref() {
+            Some(offset) => (input - offset.val().unsqueeze_dim::<4>(0)) * mask, // [batch, 540, 90, 90]
+            None => input * mask, // [batch, 540, 90, 90]
+        };
+        self.encode_centred(centred)
+    }
+
+    /// The encoder on inputs already centred and masked: `(input - offset) * mask` (just
+    /// `input * mask` without an offset). Training prepares these on the CPU.
+    ///
+    /// # Shapes
+    /// - centred: `[batch, 540, 90, 90]`
+    /// - output: `[batch, k]`
+    pub fn encode_centred(&self, centred: Tensor<4>) -> Tensor<2> {
+        match self {
+            Self::Convolutional(c) => c.encode_centred(centred),
+            Self::Spectral(s) => s.encode_centred(centred),
+        }
+    }
+
+    /// Decoder g (eq. 3): the mapped BRDF of each latent vector.
+    ///
+    /// # Shapes
+    /// - latent: `[batch, k]`
+    /// - output: `[batch, 540, 90, 90]` mapped values (invalid cells are meaningless)
+    pub fn decode(&self, latent: Tensor<2>) -> Tensor<4> {
+        let y = self.decode_deviation(latent); // [batch, 540, 90, 90]
+        match self.offset_ref() {
+            Some(offset) => y + offset.val().unsqueeze_dim::<4>(0), // [batch, 540, 90, 90]
+            None => y,
+        }
+    }
+
+    /// The decoder without the fixed offset: the deviation from it (the whole output when the
+    /// configuration has no offset). Training compares this with centred targets.
+    ///
+    /// # Shapes
+    /// - latent: `[batch, k]`
+    /// - output: `[batch, 540, 90, 90]`
+    pub fn decode_deviation(&self, latent: Tensor<2>) -> Tensor<4> {
+        match self {
+            Self::Convolutional(c) => c.decode_deviation(latent),
+            Self::Spectral(s) => s.decode_deviation(latent),
+        }
+    }
+
+    /// The fixed offset, if the configuration has one (540 x 90 x 90 values, layout order).
+    pub fn offset(&self) -> Option<Vec<f32>> {
+        self.offset_ref().and_then(|p| p.val().into_data().try_into_vec().ok())
+    }
+
+    /// g(f(x)): the reconstruction the loss of eq. (4) compares with the input.
+    ///
+    /// # Shapes
+    /// - input, mask: `[batch, 540, 90, 90]`
+    /// - output: `[batch, 540, 90, 90]`
+    pub fn forward(&self, input: Tensor<4>, mask: Tensor<4>) -> Tensor<4> {
+        let latent = self.encode(input, mask); // [batch, k]
+        self.decode(latent) // [batch, 540, 90, 90]
+    }
+}
+
+#[cfg(test)]
+mod tests;

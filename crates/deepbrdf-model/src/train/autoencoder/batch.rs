@@ -1,0 +1,159 @@
+//! One batch of the autoencoder's training data, prepared on the CPU: inputs and targets
+//! centred on the fixed offset and masked, slice dropout (§3.2, Fig. 2) drawn per (seed, epoch,
+//! BRDF), and the spectral coordinates of the filled inputs for training on coordinates.
+
+use burn::prelude::*;
+use burn::tensor::TensorData;
+use deepbrdf_data::augment::{fill_missing_layout, kept_slices, SliceSelection};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+
+use crate::autoencoder::{Autoencoder, INPUT_CHANNELS, INPUT_SIDE, INPUT_VALUES};
+use crate::error::ModelError;
+use crate::training_set::TrainingSet;
+
+/// Slice dropout applied to one batch.
+pub(crate) struct Augment<'a> {
+    pub probability: f64,
+    pub selections: &'a [SliceSelection],
+    pub seed: u64,
+    pub epoch: usize,
+}
+
+impl Augment<'_> {
+    /// The kept slices for BRDF `index` in this epoch, or `None` to show it whole; a function of
+    /// (seed, epoch, index) only, so resumed runs draw the same.
+    fn kept(&self, index: usize) -> Option<Vec<usize>> {
+        let (selection, mut rng) = self.draw(index)?;
+        Some(kept_slices(&self.selections[selection], rng.random()))
+    }
+
+    /// Which selection BRDF `index` is shown with in this epoch (the same draw as
+    /// [`kept`](Self::kept)), or `None` to show it whole.
+    pub(crate) fn choice(&self, index: usize) -> Option<usize> {
+        self.draw(index).map(|(selection, _)| selection)
+    }
+
+    fn draw(&self, index: usize) -> Option<(usize, ChaCha8Rng)> {
+        let mut rng = ChaCha8Rng::seed_from_u64(self.seed ^ 0x51ce_d20f_0a5e_u64);
+        rng.set_stream(((self.epoch as u64) << 32) | index as u64);
+        if rng.random::<f64>() >= self.probability {
+            return None;
+        }
+        let selection = rng.random_range(0..self.selections.len());
+        Some((selection, rng))
+    }
+}
+
+/// One training batch, prepared on the CPU: inputs and targets centred on the fixed offset
+/// and masked, `(x - mu) * mask` (just `x * mask` without an offset), as
+/// [`crate::loss::masked_mse_centred`] expects.
+pub(crate) struct Batch {
+    /// `[batch, 540, 90, 90]`: the network's input (with slice dropout, the filled one).
+    pub input: Tensor<4>,
+    /// `[batch, 540, 90, 90]`: the centred, masked target.
+    pub target: Tensor<4>,
+    /// `[batch, 540, 90, 90]`
+    pub mask: Tensor<4>,
+    /// Valid values of each BRDF.
+    pub valid: Vec<f64>,
+}
+
+/// The spectral coordinates of every BRDF of `data` with only the slices of each selection
+/// (the missing ones filled from their nearest kept one), `[brdf][selection][K]`; the kept
+/// slices of a random selection are drawn once per (seed, BRDF, selection).
+pub(crate) fn filled_coefficients(
+    model: &Autoencoder,
+    data: &TrainingSet,
+    offset: &[f32],
+    selections: &[SliceSelection],
+    seed: u64,
+) -> crate::error::Result<Vec<Vec<Vec<f32>>>> {
+    let model = model.valid();
+    let path = model
+        .spectral()
+        .ok_or_else(|| ModelError::Invalid("coefficient training needs a spectral path".into()))?;
+    let device = model.devices().into_iter().next().unwrap_or_default();
+    let mut out = vec![Vec::with_capacity(selections.len()); data.len()];
+    for (i, slot) in out.iter_mut().enumerate() {
+        let mut rows = vec![0f32; selections.len() * INPUT_VALUES];
+        for (s, selection) in selections.iter().enumerate() {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0xf111_ed5e_u64);
+            rng.set_stream(((i as u64) << 16) | s as u64);
+            let mut filled = data.input(i).to_vec();
+            fill_missing_layout(&mut filled, &kept_slices(selection, rng.random()));
+            let row = &mut rows[s * INPUT_VALUES..(s + 1) * INPUT_VALUES];
+            centre(row, &filled, data.mask(i), Some(offset));
+        }
+        let rows = Tensor::<2>::from_data(
+            TensorData::new(rows, [selections.len(), INPUT_VALUES]),
+            &device,
+        );
+        let c: Vec<f32> =
+            path.coefficients(rows).into_data().try_into_vec().map_err(tensor_error)?;
+        *slot = c.chunks(path.size()).map(<[f32]>::to_vec).collect();
+    }
+    Ok(out)
+}
+
+/// Writes `(x - offset) * mask` into `out`, in parallel.
+fn centre(out: &mut [f32], x: &[f32], mask: &[f32], offset: Option<&[f32]>) {
+    const CHUNK: usize = 1 << 16;
+    out.par_chunks_mut(CHUNK).enumerate().for_each(|(c, o)| {
+        let range = c * CHUNK..c * CHUNK + o.len();
+        let (x, m) = (&x[range.clone()], &mask[range.clone()]);
+        match offset {
+            Some(mu) => {
+                for (((o, &x), &m), &mu) in o.iter_mut().zip(x).zip(m).zip(&mu[range]) {
+                    *o = (x - mu) * m;
+                }
+            }
+            None => {
+                for ((o, &x), &m) in o.iter_mut().zip(x).zip(m) {
+                    *o = x * m;
+                }
+            }
+        }
+    });
+}
+
+/// Stacks BRDFs `indices` of `data` into a [`Batch`] on `device`.
+pub(crate) fn batch_tensors(
+    data: &TrainingSet,
+    indices: &[usize],
+    augment: Option<&Augment>,
+    offset: Option<&[f32]>,
+    device: &Device,
+) -> Batch {
+    let shape = [indices.len(), INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE];
+    let len = indices.len() * INPUT_VALUES;
+    let mut target = vec![0f32; len];
+    let mut mask = vec![0f32; len];
+    let mut input: Option<Vec<f32>> = None;
+    let mut valid = Vec::with_capacity(indices.len());
+    for (slot, &i) in indices.iter().enumerate() {
+        let range = slot * INPUT_VALUES..(slot + 1) * INPUT_VALUES;
+        centre(&mut target[range.clone()], data.input(i), data.mask(i), offset);
+        mask[range.clone()].copy_from_slice(data.mask(i));
+        valid.push(data.mask(i).iter().map(|&m| f64::from(m)).sum());
+        if let Some(kept) = augment.and_then(|a| a.kept(i)) {
+            let input = input.get_or_insert_with(|| target.clone());
+            let mut filled = data.input(i).to_vec();
+            fill_missing_layout(&mut filled, &kept);
+            centre(&mut input[range], &filled, data.mask(i), offset);
+        } else if let Some(input) = input.as_mut() {
+            input[range.clone()].copy_from_slice(&target[range]);
+        }
+    }
+    let target = Tensor::from_data(TensorData::new(target, shape), device);
+    let input = match input {
+        Some(input) => Tensor::from_data(TensorData::new(input, shape), device),
+        None => target.clone(),
+    };
+    Batch { input, target, mask: Tensor::from_data(TensorData::new(mask, shape), device), valid }
+}
+
+pub(crate) fn tensor_error(e: impl std::fmt::Debug) -> ModelError {
+    ModelError::Invalid(format!("reading a tensor back failed: {e:?}"))
+}

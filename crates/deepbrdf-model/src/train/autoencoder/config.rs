@@ -1,0 +1,155 @@
+//! The autoencoder's training configuration (§3.2): the network, the loop's settings (Adam,
+//! schedule, epochs, batches, seed, checkpoints) side by side in one flat JSON object as
+//! earlier versions wrote it, shards per batch and slice dropout; the two presets; reading it
+//! from a file with errors that name the file.
+
+use std::path::Path;
+
+use burn::optim::AdamConfig;
+use burn::prelude::*;
+use deepbrdf_data::augment::SliceSelection;
+
+use crate::atomic::read_limited;
+use crate::autoencoder::AutoencoderConfig;
+use crate::error::ModelError;
+use crate::train::checkpoint::{self, CHECKPOINT_FILE};
+use crate::train::config::{adam, LoopConfig};
+
+/// Everything that determines a training run of the autoencoder. Saved as JSON beside the
+/// checkpoint and in the model's provenance.
+#[derive(Config, Debug)]
+pub struct TrainConfig {
+    /// The network.
+    pub model: AutoencoderConfig,
+    /// Adam's settings (§3.2: Adam [KB14]).
+    pub optimizer: AdamConfig,
+    /// Initial learning rate (§3.2: 2e-5).
+    #[config(default = 2e-5)]
+    pub learning_rate: f64,
+    /// The learning rate falls along a half cosine to `learning_rate * final_lr_factor` at the
+    /// last step; 1.0 keeps it constant (the paper's setting).
+    #[config(default = 1.0)]
+    pub final_lr_factor: f64,
+    /// Passes over the training set (§3.2: 1000).
+    #[config(default = 1000)]
+    pub epochs: usize,
+    /// BRDFs per mini-batch (§3.2: 32).
+    #[config(default = 32)]
+    pub batch_size: usize,
+    /// Seed of the weight initialisation, the shuffling and the slice dropout.
+    #[config(default = 0)]
+    pub seed: u64,
+    /// A checkpoint is written at the end of every epoch and, within an epoch, after a batch
+    /// once this many seconds have passed since the last one.
+    #[config(default = 60.0)]
+    pub checkpoint_seconds: f64,
+    /// Each batch of a convolutional network is split into this many shards computed in
+    /// parallel on CPU backends (1 on a GPU). Results depend on it (summation order), so it is
+    /// part of the configuration.
+    #[config(default = 1)]
+    pub threads: usize,
+    /// Slice-dropout augmentation (§3.2, Fig. 2); none in the paper's training.
+    #[config(default = "None")]
+    pub slice_dropout: Option<SliceDropoutConfig>,
+}
+
+/// Slice-dropout augmentation: some training inputs lose phi_d slices, each missing slice
+/// filled from its nearest kept one (§3.2, `deepbrdf_data::augment`), while the target stays
+/// the full BRDF, so the network learns the Fig. 2 task of completing sparse inputs.
+#[derive(Config, Debug, PartialEq)]
+pub struct SliceDropoutConfig {
+    /// Probability that a training input is shown with missing slices.
+    #[config(default = 0.5)]
+    pub probability: f64,
+    /// The selections drawn from, uniformly (`every:N` or `random:K`, as
+    /// `deepbrdf_data::augment::SliceSelection` parses them); Fig. 2 uses 1/3 and 1/9.
+    #[config(default = "vec![\"every:3\".to_string(), \"every:9\".to_string()]")]
+    pub selections: Vec<String>,
+}
+
+impl SliceDropoutConfig {
+    /// The parsed selections, or an error naming the bad one.
+    pub fn parsed(&self) -> crate::error::Result<Vec<SliceSelection>> {
+        if !(0.0..=1.0).contains(&self.probability) {
+            return Err(ModelError::Invalid(format!(
+                "slice-dropout probability {} is not in [0, 1]",
+                self.probability
+            )));
+        }
+        if self.selections.is_empty() {
+            return Err(ModelError::Invalid("slice dropout needs at least one selection".into()));
+        }
+        self.selections.iter().map(|s| Ok(s.parse::<SliceSelection>()?)).collect()
+    }
+}
+
+/// Largest configuration file read (they are a few hundred bytes).
+const MAX_CONFIG_BYTES: u64 = 1 << 20;
+
+impl TrainConfig {
+    /// §3.2's settings: Table 1, Adam with lr 2e-5, batches of 32, 1000 epochs.
+    pub fn paper(k: usize) -> Self {
+        Self::new(AutoencoderConfig::paper(k), adam())
+    }
+
+    /// The CPU preset: the spectral network of [`AutoencoderConfig::cpu`], Adam 1e-3 with
+    /// cosine decay to 5e-5, batches of 8, 1000 epochs as the paper, slice dropout (half the
+    /// inputs shown with 1/3 or 1/9 of the slices, §3.2) (about 15 s for 100 BRDFs on two
+    /// cores, plus ~20 s for the basis fit and the projection of the filled inputs).
+    pub fn cpu(k: usize) -> Self {
+        Self::new(AutoencoderConfig::cpu(k), adam())
+            .with_learning_rate(1e-3)
+            .with_final_lr_factor(0.05)
+            .with_epochs(1000)
+            .with_batch_size(8)
+            .with_threads(1)
+            .with_slice_dropout(Some(SliceDropoutConfig::new()))
+    }
+
+    /// The configuration in the JSON file `path`, checked; an error names the file and the
+    /// problem (unreadable, not JSON, a missing or unknown field, a value out of range).
+    pub fn from_file(path: &Path) -> crate::error::Result<Self> {
+        let bytes = read_limited(path, MAX_CONFIG_BYTES)?;
+        let config: Self = serde_json::from_slice(&bytes)
+            .map_err(|e| ModelError::format(path, format!("not a training configuration: {e}")))?;
+        config.validate().map_err(|e| ModelError::format(path, e.to_string()))?;
+        Ok(config)
+    }
+
+    /// The loop's settings of this configuration.
+    pub fn loop_config(&self) -> LoopConfig {
+        LoopConfig::new(self.optimizer.clone())
+            .with_learning_rate(self.learning_rate)
+            .with_final_lr_factor(self.final_lr_factor)
+            .with_epochs(self.epochs)
+            .with_batch_size(self.batch_size)
+            .with_seed(self.seed)
+            .with_checkpoint_seconds(self.checkpoint_seconds)
+    }
+
+    /// Checks the settings once.
+    pub fn validate(&self) -> crate::error::Result<()> {
+        self.model.validate()?;
+        self.loop_config().validate()?;
+        if self.threads == 0 || self.threads > 64 {
+            return Err(ModelError::Invalid(format!("{} threads (1 to 64)", self.threads)));
+        }
+        if let Some(dropout) = &self.slice_dropout {
+            dropout.parsed()?;
+        }
+        Ok(())
+    }
+
+    /// The learning rate of step `step` of `total` ([`LoopConfig::learning_rate_at`]).
+    pub fn learning_rate_at(&self, step: usize, total: usize) -> f64 {
+        self.loop_config().learning_rate_at(step, total)
+    }
+}
+
+/// The configuration of the run saved in `out_dir` (from its checkpoint), to resume it.
+pub fn saved_config(out_dir: &Path) -> crate::error::Result<TrainConfig> {
+    let path = out_dir.join(CHECKPOINT_FILE);
+    let state = checkpoint::saved_state(&path)?;
+    serde_json::from_value(state.config)
+        .map_err(|e| ModelError::format(&path, format!("bad configuration: {e}")))
+}

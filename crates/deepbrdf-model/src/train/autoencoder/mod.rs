@@ -1,0 +1,153 @@
+//! Training of the autoencoder (§3.2) through the shared loop ([`crate::train::run`]): Adam on
+//! the masked L2 loss of eq. (4), seeded shuffling, slice dropout, checkpoints that resume
+//! exactly, and the final per-BRDF evaluation.
+
+mod batch;
+mod config;
+mod step;
+
+use std::path::Path;
+
+use burn::prelude::*;
+use deepbrdf_data::Progress;
+
+pub use config::{saved_config, SliceDropoutConfig, TrainConfig};
+pub(crate) use step::{coefficient_gradients, gradients};
+
+use crate::autoencoder::{legacy, Autoencoder, INPUT_VALUES};
+use crate::error::ModelError;
+use crate::train::checkpoint::{self, checkpoint_path};
+use crate::train::log::EpochRecord;
+use crate::train::run::{run, Session};
+use crate::training_set::TrainingSet;
+use batch::{batch_tensors, tensor_error};
+use step::AutoencoderStep;
+
+/// A trained network and how it was trained.
+#[derive(Debug)]
+pub struct Trained {
+    /// The network, on the caller's (non-autodiff) device.
+    pub model: Autoencoder,
+    /// The run's configuration.
+    pub config: TrainConfig,
+    /// The per-epoch log.
+    pub log: Vec<EpochRecord>,
+    /// Seconds spent training (over all resumed pieces).
+    pub seconds: f64,
+    /// Fingerprint of the training data.
+    pub data_fingerprint: String,
+    /// Final mapped-space MSE over valid values of each training BRDF, in set order.
+    pub per_material_mse: Vec<f64>,
+}
+
+impl Trained {
+    /// Mean over the training BRDFs of the mapped-space MSE.
+    pub fn mean_mse(&self) -> f64 {
+        self.per_material_mse.iter().sum::<f64>() / self.per_material_mse.len().max(1) as f64
+    }
+
+    /// The last epoch's training loss.
+    pub fn final_loss(&self) -> f64 {
+        self.log.last().map_or(f64::NAN, |r| r.loss)
+    }
+}
+
+/// Trains the autoencoder of `config` on `data`, keeping its checkpoint, configuration and log
+/// in `out_dir`.
+///
+/// With `resume`, a checkpoint in `out_dir` is continued exactly where it stopped (it must
+/// have been written with the same configuration and data); without a checkpoint the run
+/// starts afresh. Without `resume`, an existing checkpoint is an error: nothing is overwritten.
+/// A run whose checkpoint has all its epochs only evaluates and returns the network.
+pub fn train(
+    config: &TrainConfig,
+    data: &TrainingSet,
+    out_dir: &Path,
+    resume: bool,
+    progress: &dyn Progress,
+    device: &Device,
+) -> crate::error::Result<Trained> {
+    train_in(config, data, &Session::new(out_dir, resume, progress, &label(config)), device)
+}
+
+fn label(config: &TrainConfig) -> String {
+    format!("training k={}", config.model.latent)
+}
+
+/// [`train`] in `session`.
+fn train_in(
+    config: &TrainConfig,
+    data: &TrainingSet,
+    session: &Session<'_>,
+    device: &Device,
+) -> crate::error::Result<Trained> {
+    config.validate()?;
+    let identity = serde_json::to_value(config)
+        .map_err(|e| ModelError::Invalid(format!("cannot serialise the configuration: {e}")))?;
+    let path = checkpoint_path(session.dir());
+    if path.exists() && session.resumes() {
+        let saved = checkpoint::saved_state(&path)?;
+        if saved.config.get("model").is_some_and(legacy::is_legacy) {
+            return Err(ModelError::format(
+                &path,
+                "this checkpoint was written by an earlier version of deepbrdf (before the \
+                 network architectures became variants) and cannot be resumed; a finished run's \
+                 model/ still loads; to train again, start a new run in another directory",
+            ));
+        }
+    }
+    let fingerprint = data.fingerprint();
+    let mut step = AutoencoderStep::new(config, data)?;
+    let outcome = run(
+        &config.loop_config(),
+        &identity,
+        &fingerprint,
+        data.len(),
+        &mut step,
+        session,
+        device,
+    )?;
+    let model = outcome.model.valid();
+    let per_material_mse = evaluate(&model, data, config.batch_size, session.progress())?;
+    Ok(Trained {
+        model,
+        config: config.clone(),
+        log: outcome.log,
+        seconds: outcome.seconds,
+        data_fingerprint: fingerprint,
+        per_material_mse,
+    })
+}
+
+/// The mapped-space MSE over valid values of each BRDF of `data` (eq. 4 per BRDF), with the
+/// network in inference mode.
+pub fn evaluate(
+    model: &Autoencoder,
+    data: &TrainingSet,
+    batch_size: usize,
+    progress: &dyn Progress,
+) -> crate::error::Result<Vec<f64>> {
+    let model = model.valid();
+    let device = model.devices().into_iter().next().unwrap_or_default().without_autodiff();
+    let offset = model.offset();
+    let mut errors = Vec::with_capacity(data.len());
+    let indices: Vec<usize> = (0..data.len()).collect();
+    progress.start(data.len() as u64, "evaluating");
+    for chunk in indices.chunks(batch_size.max(1)) {
+        let b = batch_tensors(data, chunk, None, offset.as_deref(), &device);
+        let deviation = model.decode_deviation(model.encode_centred(b.input));
+        let batch = chunk.len();
+        let diff = deviation * b.mask - b.target; // [batch, 540, 90, 90]
+        let sq = (diff.clone() * diff).reshape([batch, INPUT_VALUES]).sum_dim(1); // [batch, 1]
+        let sq: Vec<f32> = sq.into_data().try_into_vec().map_err(tensor_error)?;
+        for (s, v) in sq.iter().zip(&b.valid) {
+            errors.push(f64::from(*s) / v.max(1.0));
+        }
+        progress.advance(batch as u64);
+    }
+    progress.finish();
+    Ok(errors)
+}
+
+#[cfg(test)]
+mod tests;

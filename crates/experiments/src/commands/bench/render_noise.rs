@@ -1,0 +1,146 @@
+//! `experiments bench render-noise`: the renderer's efficiency at equal noise (issue 16). For a
+//! Lambertian, an analytic Lambertian + GGX plastic and measured materials, under sun and sky and
+//! under a constant environment, prints seconds per image, the relative noise (standard deviation
+//! over fully covered pixels of the difference of two seeds' renders, divided by sqrt(2) and by
+//! the mean pixel value) and the efficiency `1 / (noise^2 x seconds)`, which does not depend on
+//! the sample count for an unbiased estimator.
+use crate::data_args::CacheArg;
+use anyhow::Context;
+use deepbrdf_data::dataset::load_material;
+use deepbrdf_data::{Progress, Silent};
+use deepbrdf_render::{
+    render, Brdf, Image, Lambertian, LightSpec, MerlBrdf, RenderSettings, SceneConfig, Sum,
+};
+use std::time::Instant;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Measured materials (bundled names or MERL .binary files), comma separated; the analytic
+    /// Lambertian and plastic are always measured first.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "chrome,gold-metallic-paint,blue-fabric,rgl/satin_blue_rgb,rgl/cg_sunflower_rgb,rgl/paper_white_rgb"
+    )]
+    pub materials: Vec<String>,
+    /// Lights (as `experiments render --light`), separated by semicolons.
+    #[arg(long, value_delimiter = ';', default_value = "sun:40,30;const")]
+    pub lights: Vec<String>,
+    /// Image side in pixels.
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=8192))]
+    pub size: u32,
+    /// Samples per pixel.
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub spp: u32,
+    #[command(flatten)]
+    pub cache: CacheArg,
+}
+
+/// Relative noise of two renders of the same scene with different seeds: over the pixels fully
+/// covered in both, the standard deviation of the per-pixel difference of the channel means,
+/// divided by sqrt(2) (one render's noise), over the mean pixel value. `None` when no pixel is
+/// covered or the image is black.
+pub fn relative_noise(a: &Image, b: &Image) -> Option<f64> {
+    let mut diffs = Vec::new();
+    let mut sum = 0.0;
+    for (((p, q), &ca), &cb) in
+        a.pixels().iter().zip(b.pixels()).zip(a.coverage()).zip(b.coverage())
+    {
+        if ca < 1.0 || cb < 1.0 {
+            continue;
+        }
+        let (mp, mq) = (mean3(p), mean3(q));
+        diffs.push(mp - mq);
+        sum += 0.5 * (mp + mq);
+    }
+    let n = diffs.len() as f64;
+    if n < 2.0 || !(sum > 0.0) {
+        return None;
+    }
+    let mean_diff = diffs.iter().sum::<f64>() / n;
+    let var = diffs.iter().map(|d| (d - mean_diff).powi(2)).sum::<f64>() / (n - 1.0);
+    Some((var / 2.0).sqrt() / (sum / n))
+}
+
+fn mean3(p: &[f32; 3]) -> f64 {
+    p.iter().map(|&v| f64::from(v)).sum::<f64>() / 3.0
+}
+
+pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
+    let threads = rayon::current_num_threads();
+    println!(
+        "bench render-noise: {0}x{0} sphere, {1} spp, {threads} threads (set RAYON_NUM_THREADS to change); noise = sd(seed 1 - seed 2) / sqrt(2) / mean over covered pixels; efficiency = 1 / (noise^2 x s)",
+        args.size, args.spp
+    );
+    let mut tables = Vec::new();
+    for spec in &args.materials {
+        let (name, table) = load_material(spec, &args.cache.cache())
+            .with_context(|| format!("loading material '{spec}'"))?;
+        tables.push((name, table));
+    }
+    let lambertian = Lambertian::new([0.5; 3]);
+    let plastic = Sum::plastic([0.3, 0.2, 0.1], 0.1, [0.04; 3]);
+    let mut brdfs: Vec<(String, Box<dyn Brdf + '_>, f64)> = vec![
+        ("lambertian 0.5".into(), Box::new(lambertian), 0.0),
+        ("plastic (lambertian + ggx 0.1)".into(), Box::new(plastic), 0.0),
+    ];
+    for (name, table) in &tables {
+        let start = Instant::now();
+        let brdf = MerlBrdf::new(table);
+        let build = start.elapsed().as_secs_f64();
+        brdfs.push((name.clone(), Box::new(brdf), build));
+    }
+    println!(
+        "{:<34} {:<10} {:>9} {:>9} {:>11} {:>9}",
+        "material", "light", "s/image", "noise", "efficiency", "build s"
+    );
+    for light in &args.lights {
+        let spec: LightSpec = light.parse().with_context(|| format!("parsing light '{light}'"))?;
+        let scene = SceneConfig { light: spec, ..Default::default() }.build()?;
+        for (name, brdf, build) in &brdfs {
+            let mut images = Vec::new();
+            let mut seconds = 0.0;
+            for seed in [1, 2] {
+                let settings =
+                    RenderSettings { size: args.size, spp: args.spp, seed, jitter: true };
+                let start = Instant::now();
+                images.push(render(&scene, brdf.as_ref(), &settings, &Silent)?);
+                seconds += start.elapsed().as_secs_f64() / 2.0;
+            }
+            let noise = relative_noise(&images[0], &images[1])
+                .with_context(|| format!("{name} under {light}: no covered, lit pixels"))?;
+            println!(
+                "{name:<34} {light:<10} {seconds:>9.3} {noise:>9.4} {:>11.1} {build:>9.3}",
+                1.0 / (noise * noise * seconds)
+            );
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn relative_noise_of_known_images() {
+        // Four covered pixels at level 2 (a) and 2 +- 0.2 alternating (b), plus uncovered and
+        // partly covered pixels that must be ignored: the difference has sd 0.2 * sqrt(4/3)
+        // (sample sd of +-0.2), so the noise is that / sqrt(2) / mean level (2, 2.1, 1.9 mean 2).
+        let a = Image::from_pixels(3, 2, vec![[2.0; 3]; 6], vec![1.0, 1.0, 1.0, 1.0, 0.5, 0.0])
+            .unwrap();
+        let b = Image::from_pixels(
+            3,
+            2,
+            vec![[2.2; 3], [1.8; 3], [2.2; 3], [1.8; 3], [9.0; 3], [9.0; 3]],
+            vec![1.0; 6],
+        )
+        .unwrap();
+        let want = 0.2 * (4.0f64 / 3.0).sqrt() / 2f64.sqrt() / 2.0;
+        let got = relative_noise(&a, &b).unwrap();
+        assert!((got - want).abs() < 1e-6, "{got} vs {want}");
+        assert_eq!(relative_noise(&a, &a), Some(0.0));
+        let black = Image::from_pixels(3, 2, vec![[0.0; 3]; 6], vec![1.0; 6]).unwrap();
+        assert_eq!(relative_noise(&black, &black), None);
+    }
+}

@@ -1,0 +1,118 @@
+//! CLI tests of what happens around a run rather than inside it (issue 15): two runs on one
+//! output folder, the lock of a killed run, a full disk and a read-only folder.
+//!
+//! The disk tests mount a small tmpfs inside a private user and mount namespace
+//! (`unshare --user --map-root-user --mount`), so they need no privileges and leave no mount
+//! behind; `unshare` and `mount` come with util-linux.
+
+use crate::util;
+use deepbrdf_data::merl::io::FILE_BYTES;
+use std::path::Path;
+use std::process::Command;
+
+/// Runs `script` under `sh` in a private user and mount namespace; returns (status, stdout,
+/// stderr).
+fn in_namespace(script: &str) -> (bool, String, String) {
+    let o = Command::new("unshare")
+        .args(["--user", "--map-root-user", "--mount", "sh", "-c", script])
+        .output()
+        .expect("unshare (util-linux) must be installed");
+    (
+        o.status.success(),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+fn s(p: &Path) -> String {
+    p.display().to_string()
+}
+
+#[test]
+fn a_second_run_on_a_locked_folder_is_refused_and_a_stale_lock_is_taken_over() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("out");
+    let cache = s(&dir.path().join("cache"));
+    std::fs::create_dir_all(&out).expect("mkdir");
+    let lock = out.join(deepbrdf_data::lock::LOCK_FILE);
+    // Another live process holds the folder's lock (util-linux flock takes the same flock(2)
+    // lock the commands take; `-o`: only flock itself holds it, not its `sleep`, so killing
+    // flock frees it as the death of a run would).
+    let mut holder = Command::new("flock")
+        .args(["-o", s(&lock).as_str(), "sleep", "60"])
+        .spawn()
+        .expect("flock (util-linux) must be installed");
+    let t0 = std::time::Instant::now();
+    while !lock.exists() && t0.elapsed().as_secs() < 10 {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(200));
+    let o = util::run(&["tabulate", "--material", "chrome", "--out", &s(&out), "--cache", &cache]);
+    let _ = holder.kill();
+    let _ = holder.wait();
+    util::assert_clean_failure(&o, "another run is writing this folder");
+    assert!(util::stderr(&o).contains(&s(&out)), "{}", util::stderr(&o));
+    assert!(!out.join("chrome.binary").exists(), "the refused run wrote nothing");
+
+    // The holder is dead (killed): its lock file is still there, and the next run takes over.
+    assert!(lock.exists());
+    std::fs::write(&lock, "pid 999999999\ncommand experiments tabulate\n").expect("write");
+    let o = util::run(&["tabulate", "--material", "chrome", "--out", &s(&out), "--cache", &cache]);
+    assert!(o.status.success(), "{}", util::stderr(&o));
+    assert_eq!(
+        std::fs::metadata(out.join("chrome.binary")).expect("written").len(),
+        FILE_BYTES as u64
+    );
+}
+
+#[test]
+fn a_full_disk_and_a_read_only_folder_give_clear_errors_and_keep_what_was_there() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mnt = dir.path().join("mnt");
+    std::fs::create_dir_all(&mnt).expect("mkdir");
+    let cache = s(&dir.path().join("cache"));
+    let exe = env!("CARGO_BIN_EXE_experiments");
+    let (m, d) = (s(&mnt), s(dir.path()));
+    // 40 MiB hold one MERL file (35 MB) but not a second one, nor a temporary copy beside it.
+    let script = format!(
+        "set -u; mount -t tmpfs -o size=40m tmpfs {m} || exit 90
+         {exe} tabulate --material chrome --out {m}/out --cache {cache} --quiet || exit 91
+         mv {m}/out/chrome.binary {m}/out/steel.binary
+         cp {m}/out/steel.binary {d}/before.binary
+         echo '== new file'
+         {exe} tabulate --material gold-metallic-paint --out {m}/out --cache {cache} --quiet; echo rc=$?
+         echo '== replacing a file'
+         {exe} tabulate --material steel --out {m}/out --cache {cache} --force --quiet; echo rc=$?
+         echo '== listing'; ls -A {m}/out
+         cp {m}/out/steel.binary {d}/after.binary
+         mount -o remount,ro {m} || exit 92
+         echo '== read-only'
+         {exe} tabulate --material chrome --out {m}/out2 --cache {cache} --quiet; echo rc=$?
+         exit 0"
+    );
+    let (ok, out, err) = in_namespace(&script);
+    assert!(ok, "namespace script failed: {out}\n{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    let sections: Vec<&str> = out.split("== ").collect();
+    let section = |name: &str| sections.iter().find(|s| s.starts_with(name)).copied().unwrap_or("");
+    // Both writes on the full disk failed with an exit code, not a crash.
+    for name in ["new file", "replacing a file"] {
+        assert!(section(name).contains("rc=1"), "{name}: {out}\n{err}");
+    }
+    assert!(err.matches("No space left on device").count() >= 2, "{err}");
+    assert!(err.contains("gold-metallic-paint.binary") || err.contains(&m), "{err}");
+    // Nothing half-written is left under a final name or as a temporary file.
+    let listing = section("listing");
+    assert!(listing.contains("steel.binary"), "{listing}");
+    assert!(!listing.contains("gold-metallic-paint.binary"), "{listing}");
+    assert!(!listing.contains(".tmp"), "{listing}");
+    // The file that was there is intact, byte for byte.
+    let before = std::fs::read(dir.path().join("before.binary")).expect("before");
+    let after = std::fs::read(dir.path().join("after.binary")).expect("after");
+    assert_eq!(before.len(), FILE_BYTES);
+    assert!(before == after, "the replaced-on-a-full-disk file changed");
+    // A read-only folder: an error that names it.
+    assert!(section("read-only").contains("rc=1"), "{out}\n{err}");
+    assert!(err.contains("Read-only file system"), "{err}");
+    assert!(err.contains("out2"), "{err}");
+}
