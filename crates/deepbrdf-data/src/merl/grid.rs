@@ -121,11 +121,23 @@ mod tests {
 
     #[test]
     fn cos_product_matches_the_grid_validity_and_known_angles() {
-        // theta_h = theta_d = 0: both directions at the normal.
-        assert!((cos_product(cell_index(0, 0, 0)) - 1.0).abs() < 1e-12);
-        // theta_h = 0, theta_d = j/90 pi/2: both directions at theta_d, product cos^2(theta_d).
-        let td = theta_d_of(30);
-        assert!((cos_product(cell_index(0, 30, 17)) - td.cos().powi(2)).abs() < 1e-12);
+        // The first cell (bin centres at theta_h, theta_d under half a degree): both directions
+        // within a degree of the normal.
+        assert!((cos_product(cell_index(0, 0, 0)) - 1.0).abs() < 2e-4);
+        // At each cell's sample angles, the product of the two directions' cosines.
+        for (i, j, k) in [(0, 30, 17), (10, 45, 90), (40, 20, 3), (70, 10, 170)] {
+            let a = crate::merl::coords::HalfDiff {
+                theta_h: theta_h_of(i),
+                phi_h: 0.0,
+                theta_d: theta_d_of(j),
+                phi_d: phi_d_of(k),
+            };
+            let (wi, wo) = a.to_dirs();
+            assert!(
+                (cos_product(cell_index(i, j, k)) - wi[2] * wo[2]).abs() < 1e-12,
+                "{i} {j} {k}"
+            );
+        }
         for cell in (0..CELLS).step_by(97) {
             let (i, j, k) = cell_coords(cell);
             assert_eq!(cos_product(cell) > 0.0, cell_is_valid(i, j, k), "cell {cell}");

@@ -127,7 +127,7 @@ impl RglBrdf {
         }
         let (_, theta_i) = t.f32_field("theta_i", 1)?;
         if theta_i.len() < 2
-            || theta_i.windows(2).any(|w| !(w[0] < w[1]))
+            || theta_i.windows(2).any(|w| w[0].partial_cmp(&w[1]) != Some(std::cmp::Ordering::Less))
             || theta_i[0] < 0.0
             || theta_i[theta_i.len() - 1] > PI / 2.0 + 1e-4
         {
@@ -265,7 +265,8 @@ impl RglBrdf {
     /// the luminance warp, then the VNDF warp. Returns wo and its density (solid angle), or
     /// `None` when wi or the sampled wo is at or below the horizon.
     pub fn sample(&self, u: [f32; 2], wi: [f32; 3]) -> Option<([f32; 3], f32)> {
-        if !(wi[2] > 0.0) {
+        // NaN-safe: a NaN direction is not above the horizon.
+        if wi[2].is_nan() || wi[2] <= 0.0 {
             return None;
         }
         let params = [wi[1].atan2(wi[0]), elevation(wi)];
@@ -278,7 +279,7 @@ impl RglBrdf {
         let wm = [cp * st, sp * st, ct];
         let k = 2.0 * dot(wm, wi);
         let wo = [wm[0] * k - wi[0], wm[1] * k - wi[1], wm[2] * k - wi[2]];
-        if !(wo[2] > 0.0) {
+        if wo[2].is_nan() || wo[2] <= 0.0 {
             return None;
         }
         let jacobian = (2.0 * PI * PI * u_wm[0] * st).max(1e-6) * 4.0 * dot(wi, wm);

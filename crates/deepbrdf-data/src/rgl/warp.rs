@@ -71,7 +71,8 @@ impl Marginal2D {
             if values.is_empty() {
                 return Err(format!("parameter {d} has no values"));
             }
-            if values.windows(2).any(|w| !(w[0] < w[1])) {
+            if values.windows(2).any(|w| w[0].partial_cmp(&w[1]) != Some(std::cmp::Ordering::Less))
+            {
                 return Err(format!("parameter {d} values are not strictly increasing"));
             }
             strides[d] = if values.len() > 1 { slices } else { 0 };
