@@ -123,6 +123,8 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         }
         None => {
             let out = args.out.clone().context("--out DIR is required")?;
+            // The configuration first: a bad --config file leaves no folder behind.
+            let config = args.config()?;
             lock = FolderLock::acquire(&out)?;
             if checkpoint_path(&out).exists() {
                 bail!(
@@ -132,7 +134,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                     out.display()
                 );
             }
-            (out, args.config()?, false)
+            (out, config, false)
         }
     };
     let data = args.data.load(progress)?;
