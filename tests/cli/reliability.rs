@@ -116,3 +116,119 @@ fn a_full_disk_and_a_read_only_folder_give_clear_errors_and_keep_what_was_there(
     assert!(err.contains("Read-only file system"), "{err}");
     assert!(err.contains("out2"), "{err}");
 }
+
+/// Trials of the kill test: [`KILL_TRIALS_VAR`] if set (the reliability table in the README was
+/// measured with 20), else 2 (CI).
+const KILL_TRIALS_VAR: &str = "DEEPBRDF_KILL_TRIALS";
+
+/// The bytes a finished training run leaves that must not depend on how often it was killed.
+fn run_outputs(run: &Path) -> Vec<(String, Vec<u8>)> {
+    ["model/weights.bpk", "model/basis.f16", "train_log.csv"]
+        .iter()
+        .map(|f| (f.to_string(), std::fs::read(run.join(f)).unwrap_or_default()))
+        .collect()
+}
+
+#[test]
+fn train_killed_at_random_moments_resumes_to_bit_identical_weights() {
+    use deepbrdf_model::burn::config::Config as _;
+    use deepbrdf_model::{AutoencoderConfig, TrainConfig};
+    use rand::{Rng, SeedableRng};
+    use std::time::{Duration, Instant};
+
+    let dir = tempfile::tempdir().expect("tempdir");
+    let data = util::write_data(dir.path(), 3);
+    // The cpu preset's kind of network, tiny; a checkpoint after every batch, so kills land in
+    // epochs, in checkpoint writes and in the final save alike.
+    let mut config =
+        TrainConfig::cpu(2).with_epochs(60).with_batch_size(1).with_checkpoint_seconds(0.0);
+    config.model = AutoencoderConfig::spectral(2, 3, Some(8));
+    let config_path = dir.path().join("tiny.json");
+    config.save(&config_path).expect("config");
+    let exe = env!("CARGO_BIN_EXE_experiments");
+    let fresh = |out: &Path| {
+        Command::new(exe)
+            .args([
+                "train",
+                "--config",
+                &s(&config_path),
+                "--data",
+                &s(&data),
+                "--out",
+                &s(out),
+                "-q",
+            ])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("spawn train")
+    };
+    let resume = |out: &Path| {
+        Command::new(exe)
+            .args(["train", "--resume", &s(out), "--data", &s(&data), "-q"])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("spawn train --resume")
+    };
+    let start = |out: &Path| {
+        if deepbrdf_model::train::checkpoint_path(out).is_file() {
+            resume(out)
+        } else {
+            fresh(out)
+        }
+    };
+
+    let reference = dir.path().join("reference");
+    let t = Instant::now();
+    let o = fresh(&reference).wait_with_output().expect("reference run");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let full = t.elapsed();
+    let expected = run_outputs(&reference);
+    assert!(expected.iter().all(|(_, b)| !b.is_empty()), "the reference run left its files");
+
+    let trials: usize =
+        std::env::var(KILL_TRIALS_VAR).ok().and_then(|v| v.parse().ok()).unwrap_or(2);
+    let mut kills = 0;
+    for trial in 0..trials {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(trial as u64);
+        let out = dir.path().join(format!("killed-{trial}"));
+        // Up to three kills per trial at random moments over the run's length, then a run to the
+        // end (a fresh start if no checkpoint was written yet, else --resume).
+        for _ in 0..rng.random_range(1..=3) {
+            let mut child = start(&out);
+            let delay = full.mul_f64(rng.random_range(0.05..1.1));
+            let t = Instant::now();
+            let mut finished = false;
+            while t.elapsed() < delay {
+                if child.try_wait().expect("try_wait").is_some() {
+                    finished = true;
+                    break;
+                }
+                std::thread::sleep(Duration::from_millis(5));
+            }
+            if !finished {
+                child.kill().expect("SIGKILL");
+                kills += 1;
+            }
+            let _ = child.wait();
+        }
+        let o = start(&out).wait_with_output().expect("final run");
+        assert!(
+            o.status.success() || run_outputs(&out) == expected,
+            "trial {trial}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let got = run_outputs(&out);
+        for ((name, want), (_, have)) in expected.iter().zip(&got) {
+            assert!(want == have, "trial {trial}: {name} differs from the uninterrupted run's");
+        }
+        // The model loads: a table encodes through it.
+        let o = util::run_in(dir.path(), &["encode", &s(&out), &s(&data.join("m1.binary"))]);
+        assert!(o.status.success(), "trial {trial}: {}", util::stderr(&o));
+    }
+    eprintln!(
+        "kill test: {trials} trials, {kills} SIGKILLs, all bit-identical to the uninterrupted run"
+    );
+    assert!(kills > 0, "no run was actually killed");
+}
