@@ -195,17 +195,35 @@ fn train_killed_at_random_moments_resumes_to_bit_identical_weights() {
         let out = dir.path().join(format!("killed-{trial}"));
         // Up to three kills per trial at random moments over the run's length, then a run to the
         // end (a fresh start if no checkpoint was written yet, else --resume).
-        for _ in 0..rng.random_range(1..=3) {
+        for attempt in 0..rng.random_range(1..=3) {
             let mut child = start(&out);
+            // The first attempt of a trial is killed a few milliseconds after its first
+            // checkpoint appears (so every trial kills a run in the middle, however fast or
+            // loaded the machine is); later ones at a random moment over the run's length.
+            let after_checkpoint = attempt == 0;
             let delay = full.mul_f64(rng.random_range(0.05..1.1));
+            let extra = Duration::from_millis(rng.random_range(0..40));
+            let checkpoint = deepbrdf_model::train::checkpoint_path(&out);
+            let had_checkpoint = checkpoint.is_file();
             let t = Instant::now();
             let mut finished = false;
-            while t.elapsed() < delay {
+            let mut seen: Option<Instant> = None;
+            loop {
                 if child.try_wait().expect("try_wait").is_some() {
                     finished = true;
                     break;
                 }
-                std::thread::sleep(Duration::from_millis(5));
+                if after_checkpoint {
+                    if seen.is_none() && (had_checkpoint || checkpoint.is_file()) {
+                        seen = Some(Instant::now());
+                    }
+                    if seen.is_some_and(|at| at.elapsed() >= extra) {
+                        break;
+                    }
+                } else if t.elapsed() >= delay {
+                    break;
+                }
+                std::thread::sleep(Duration::from_millis(1));
             }
             if !finished {
                 child.kill().expect("SIGKILL");
@@ -226,6 +244,7 @@ fn train_killed_at_random_moments_resumes_to_bit_identical_weights() {
         // The model loads: a table encodes through it.
         let o = util::run_in(dir.path(), &["encode", &s(&out), &s(&data.join("m1.binary"))]);
         assert!(o.status.success(), "trial {trial}: {}", util::stderr(&o));
+        eprintln!("kill test: trial {trial} bit-identical ({kills} SIGKILLs so far)");
     }
     eprintln!(
         "kill test: {trials} trials, {kills} SIGKILLs, all bit-identical to the uninterrupted run"
