@@ -7,6 +7,7 @@ mod device_arg;
 mod latent_file;
 mod mapped_input;
 mod measured_brdf;
+mod model_arg;
 mod nested_baseline;
 mod progress;
 mod progress_log;
