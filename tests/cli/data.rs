@@ -58,6 +58,25 @@ fn tabulate_one_material_then_info_reads_it_and_matches_the_bundled_one() {
     // Running again leaves the identical file alone; a different file is not overwritten.
     let o = util::run(&["tabulate", "--material", "chrome", "--out", &out_s, "--cache", &cache]);
     assert!(util::stdout(&o).contains("1 unchanged"), "{}", util::stdout(&o));
+
+    // A damaged cache file is not used: it is rebuilt, with a warning naming it and the problem.
+    let tables = Path::new(&cache).join("tables");
+    let cached: Vec<_> = std::fs::read_dir(&tables).expect("tables").flatten().collect();
+    assert_eq!(cached.len(), 1, "{cached:?}");
+    let cached = cached[0].path();
+    let mut bytes = std::fs::read(&cached).expect("read");
+    let last = bytes.len() - 1;
+    bytes[last] ^= 0x40;
+    std::fs::write(&cached, &bytes).expect("damage");
+    let o = util::run(&["info", "merl/chrome", "--cache", &cache]);
+    assert!(o.status.success(), "{}", util::stderr(&o));
+    let err = util::stderr(&o);
+    assert!(err.contains("warning:") && err.contains("checksum mismatch"), "{err}");
+    assert!(err.contains(&*cached.to_string_lossy()), "{err}");
+    assert_eq!(util::stdout(&o), bundled, "the rebuilt table is the same table");
+    let o = util::run(&["info", "merl/chrome", "--cache", &cache]);
+    assert!(!util::stderr(&o).contains("warning"), "{}", util::stderr(&o));
+
     std::fs::write(&file, b"precious user data").expect("write");
     let o = util::run(&["tabulate", "--material", "chrome", "--out", &out_s, "--cache", &cache]);
     util::assert_clean_failure(&o, "--force");

@@ -40,7 +40,8 @@ pub enum Outcome {
     Hit,
     /// Tabulated: there was no cache file (or caching is disabled).
     Computed,
-    /// Tabulated because the cache file was corrupt, truncated or foreign.
+    /// Tabulated because the cache file was corrupt, truncated or foreign (and rebuilt, with a
+    /// `log` warning naming the file and the problem).
     Recomputed,
 }
 
@@ -147,7 +148,10 @@ impl Cache {
         let outcome = match read_cached(&path, key, version) {
             Ok(Some(table)) => return Ok((table, Outcome::Hit)),
             Ok(None) => Outcome::Computed,
-            Err(_) => Outcome::Recomputed,
+            Err(e) => {
+                log::warn!("{e}: not used, tabulating the table again");
+                Outcome::Recomputed
+            }
         };
         let table = compute()?;
         store(&path, key, version, &table)?;

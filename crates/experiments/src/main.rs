@@ -15,12 +15,14 @@ mod readme_block;
 mod robustness;
 mod scene_args;
 mod slices_figure;
+mod warnings;
 
 use clap::Parser;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
     let cli = cli::Cli::parse();
+    warnings::install();
     match commands::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
