@@ -330,22 +330,7 @@ impl ModelArtifact {
         let dir = resolve_dir(path)?;
         let manifest_path = dir.join(MANIFEST_FILE);
         let text = read_limited(&manifest_path, 64 << 20)?;
-        let manifest: Manifest = serde_json::from_slice(&text).map_err(|e| {
-            ModelError::format(&manifest_path, format!("not a DeepBRDF model manifest: {e}"))
-        })?;
-        if manifest.format != FORMAT || !(1..=VERSION).contains(&manifest.version) {
-            return Err(ModelError::format(
-                &manifest_path,
-                format!(
-                    "format {} version {}, expected {FORMAT} version 1 to {VERSION}",
-                    manifest.format, manifest.version
-                ),
-            ));
-        }
-        let config = AutoencoderConfig::try_from(manifest.config.clone()).map_err(|e| {
-            ModelError::format(&manifest_path, format!("bad network configuration: {e}"))
-        })?;
-        config.validate()?;
+        let (manifest, config) = parse_manifest(&manifest_path, &text)?;
         let weights_path = dir.join(WEIGHTS_FILE);
         let weights = read_limited(&weights_path, 4 << 30)?;
         if part_of(&weights, WEIGHTS_FILE) != manifest.weights {
@@ -404,6 +389,26 @@ impl ModelArtifact {
             id: manifest.id,
         })
     }
+}
+
+/// Parses and checks `model.json` (its bytes `text`, read from `path`): format, version and a
+/// valid network configuration (sizes in range, so nothing is allocated for an absurd one).
+fn parse_manifest(path: &Path, text: &[u8]) -> Result<(Manifest, AutoencoderConfig)> {
+    let manifest: Manifest = serde_json::from_slice(text)
+        .map_err(|e| ModelError::format(path, format!("not a DeepBRDF model manifest: {e}")))?;
+    if manifest.format != FORMAT || !(1..=VERSION).contains(&manifest.version) {
+        return Err(ModelError::format(
+            path,
+            format!(
+                "format {} version {}, expected {FORMAT} version 1 to {VERSION}",
+                manifest.format, manifest.version
+            ),
+        ));
+    }
+    let config = AutoencoderConfig::try_from(manifest.config.clone())
+        .map_err(|e| ModelError::format(path, format!("bad network configuration: {e}")))?;
+    config.validate()?;
+    Ok((manifest, config))
 }
 
 /// The reference's checksum is taken over its values (little-endian f32), not over the file,
@@ -506,12 +511,16 @@ fn replace_dir(tmp: &Path, dir: &Path) -> Result<()> {
 }
 
 #[cfg(test)]
+#[path = "artifact_fuzz.rs"]
+mod fuzz;
+
+#[cfg(test)]
 mod tests {
     use super::*;
     use crate::device::DeviceKind;
     use deepbrdf_data::merl::VALUES;
 
-    fn tiny() -> AutoencoderConfig {
+    pub(super) fn tiny() -> AutoencoderConfig {
         let layers = crate::autoencoder::ConvolutionalConfig::new()
             .with_projection(Some(1))
             .with_encoder_channels([1, 1, 1])
@@ -521,7 +530,7 @@ mod tests {
         AutoencoderConfig::convolutional(2, layers)
     }
 
-    fn provenance() -> Provenance {
+    pub(super) fn provenance() -> Provenance {
         Provenance {
             data_label: "synthetic".into(),
             materials: vec!["a".into(), "b".into()],

@@ -17,7 +17,6 @@ use deepbrdf_data::dataset::Dataset;
 use deepbrdf_data::files::write_atomic;
 use deepbrdf_data::Progress;
 use deepbrdf_eval::harness::{self, HarnessConfig, Materials, Measure, Mode, Results};
-use deepbrdf_model::burn::config::Config as _;
 use deepbrdf_model::{Preset, TrainConfig};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -80,9 +79,7 @@ impl Args {
     /// The training configuration of each k.
     fn config_for(&self) -> anyhow::Result<Box<dyn Fn(usize) -> TrainConfig + Send + Sync>> {
         let base = match &self.train_config {
-            Some(path) => Some(TrainConfig::load(path).map_err(|e| {
-                anyhow::anyhow!("reading the training configuration {}: {e}", path.display())
-            })?),
+            Some(path) => Some(TrainConfig::from_file(path)?),
             None => None,
         };
         let (preset, epochs, seed) = (self.preset, self.epochs, self.seed);

@@ -9,7 +9,6 @@ use crate::data_args::DataArgs;
 use anyhow::{bail, Context};
 use deepbrdf_data::lock::FolderLock;
 use deepbrdf_data::Progress;
-use deepbrdf_model::burn::config::Config;
 use deepbrdf_model::train::{checkpoint_path, saved_config};
 use deepbrdf_model::{fit, Preset, SliceDropoutConfig, TrainConfig};
 use std::path::PathBuf;
@@ -65,9 +64,7 @@ impl Args {
     /// The configuration of a new run from the preset (or file) and the overrides.
     fn config(&self) -> anyhow::Result<TrainConfig> {
         let mut config = match &self.config {
-            Some(path) => TrainConfig::load(path).map_err(|e| {
-                anyhow::anyhow!("{}: not a training configuration: {e}", path.display())
-            })?,
+            Some(path) => TrainConfig::from_file(path)?,
             None => self.preset.train_config(self.k.unwrap_or(10)),
         };
         if let Some(k) = self.k {

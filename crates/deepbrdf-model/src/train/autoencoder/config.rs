@@ -109,8 +109,12 @@ impl TrainConfig {
     /// The configuration in the JSON file `path`, checked; an error names the file and the
     /// problem (unreadable, not JSON, a missing or unknown field, a value out of range).
     pub fn from_file(path: &Path) -> crate::error::Result<Self> {
-        let bytes = read_limited(path, MAX_CONFIG_BYTES)?;
-        let config: Self = serde_json::from_slice(&bytes)
+        Self::parse(path, &read_limited(path, MAX_CONFIG_BYTES)?)
+    }
+
+    /// The configuration in `bytes` (the content of `path`, named in errors), checked.
+    pub fn parse(path: &Path, bytes: &[u8]) -> crate::error::Result<Self> {
+        let config: Self = serde_json::from_slice(bytes)
             .map_err(|e| ModelError::format(path, format!("not a training configuration: {e}")))?;
         config.validate().map_err(|e| ModelError::format(path, e.to_string()))?;
         Ok(config)
@@ -153,3 +157,7 @@ pub fn saved_config(out_dir: &Path) -> crate::error::Result<TrainConfig> {
     serde_json::from_value(state.config)
         .map_err(|e| ModelError::format(&path, format!("bad configuration: {e}")))
 }
+
+#[cfg(test)]
+#[path = "config_fuzz.rs"]
+mod fuzz;

@@ -3,7 +3,6 @@
 //! <= 0.15 s on 2 cores; the paper reports 0.3 s on a GPU, IPCA 0.15 s). All measured in the
 //! same run, on the `--device` backend.
 use deepbrdf_data::Progress;
-use deepbrdf_model::burn::config::Config;
 use deepbrdf_model::timing;
 use deepbrdf_model::{Preset, TrainConfig};
 
@@ -44,9 +43,7 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         }
     };
     if let Some(path) = &args.config {
-        let config = TrainConfig::load(path).map_err(|e| {
-            anyhow::anyhow!("{}: not a training configuration: {e}", path.display())
-        })?;
+        let config = TrainConfig::from_file(path)?;
         runs.push(("config".to_string(), config));
     }
     println!("device {kind}, k = {}", args.k);
