@@ -7,6 +7,7 @@ mod convert;
 mod data;
 mod devices;
 mod fetch_merl;
+mod kill;
 mod model;
 mod reliability;
 mod render;

@@ -1,11 +1,12 @@
 //! CLI tests of what happens around a run rather than inside it (issue 15): two runs on one
-//! output folder, the lock of a killed run, a full disk and a read-only folder.
+//! output folder, the lock of a killed run, a full disk and a read-only folder, and `train` and
+//! `sweep-k` killed at random moments ([`kill`]).
 //!
 //! The disk tests mount a small tmpfs inside a private user and mount namespace
 //! (`unshare --user --map-root-user --mount`), so they need no privileges and leave no mount
 //! behind; `unshare` and `mount` come with util-linux.
 
-use crate::util;
+use crate::{kill, util};
 use deepbrdf_data::merl::io::FILE_BYTES;
 use std::path::Path;
 use std::process::Command;
@@ -117,24 +118,22 @@ fn a_full_disk_and_a_read_only_folder_give_clear_errors_and_keep_what_was_there(
     assert!(err.contains("out2"), "{err}");
 }
 
-/// Trials of the kill test: [`KILL_TRIALS_VAR`] if set (the reliability table in the README was
-/// measured with 20), else 2 (CI).
-const KILL_TRIALS_VAR: &str = "DEEPBRDF_KILL_TRIALS";
-
 /// The bytes a finished training run leaves that must not depend on how often it was killed.
 fn run_outputs(run: &Path) -> Vec<(String, Vec<u8>)> {
-    ["model/weights.bpk", "model/basis.f16", "train_log.csv"]
-        .iter()
-        .map(|f| (f.to_string(), std::fs::read(run.join(f)).unwrap_or_default()))
-        .collect()
+    kill::files(run, &["model/weights.bpk", "model/basis.f16", "train_log.csv"])
+}
+
+/// `cmd` with its output silenced but for stderr (read when a run fails).
+fn spawn(mut cmd: Command) -> std::process::Child {
+    cmd.stdout(std::process::Stdio::null()).stderr(std::process::Stdio::piped());
+    cmd.spawn().expect("spawn experiments")
 }
 
 #[test]
 fn train_killed_at_random_moments_resumes_to_bit_identical_weights() {
     use deepbrdf_model::burn::config::Config as _;
+    use deepbrdf_model::train::checkpoint_path;
     use deepbrdf_model::{AutoencoderConfig, TrainConfig};
-    use rand::{Rng, SeedableRng};
-    use std::time::{Duration, Instant};
 
     let dir = tempfile::tempdir().expect("tempdir");
     let data = util::write_data(dir.path(), 3);
@@ -146,108 +145,71 @@ fn train_killed_at_random_moments_resumes_to_bit_identical_weights() {
     let config_path = dir.path().join("tiny.json");
     config.save(&config_path).expect("config");
     let exe = env!("CARGO_BIN_EXE_experiments");
-    let fresh = |out: &Path| {
-        Command::new(exe)
-            .args([
-                "train",
-                "--config",
-                &s(&config_path),
-                "--data",
-                &s(&data),
-                "--out",
-                &s(out),
-                "-q",
-            ])
-            .stdout(std::process::Stdio::null())
-            .stderr(std::process::Stdio::piped())
-            .spawn()
-            .expect("spawn train")
-    };
-    let resume = |out: &Path| {
-        Command::new(exe)
-            .args(["train", "--resume", &s(out), "--data", &s(&data), "-q"])
-            .stdout(std::process::Stdio::null())
-            .stderr(std::process::Stdio::piped())
-            .spawn()
-            .expect("spawn train --resume")
-    };
+    // A fresh start if no checkpoint was written yet, else --resume.
     let start = |out: &Path| {
-        if deepbrdf_model::train::checkpoint_path(out).is_file() {
-            resume(out)
+        let mut cmd = Command::new(exe);
+        if checkpoint_path(out).is_file() {
+            cmd.args(["train", "--resume", &s(out), "--data", &s(&data), "-q"]);
         } else {
-            fresh(out)
+            let config = s(&config_path);
+            cmd.args(["train", "--config", &config, "--data", &s(&data), "--out", &s(out), "-q"]);
         }
+        spawn(cmd)
     };
+    let job = kill::Job {
+        name: "train",
+        start: &start,
+        progress: &|out: &Path| checkpoint_path(out),
+        outputs: &run_outputs,
+    };
+    // The model loads: a table encodes through it.
+    let check = |out: &Path| {
+        let o = util::run_in(dir.path(), &["encode", &s(out), &s(&data.join("m1.binary"))]);
+        assert!(o.status.success(), "{}", util::stderr(&o));
+    };
+    kill::kill_trials(&job, dir.path(), kill::trials(2), &check);
+}
 
-    let reference = dir.path().join("reference");
-    let t = Instant::now();
-    let o = fresh(&reference).wait_with_output().expect("reference run");
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let full = t.elapsed();
-    let expected = run_outputs(&reference);
-    assert!(expected.iter().all(|(_, b)| !b.is_empty()), "the reference run left its files");
+#[test]
+fn sweep_k_killed_at_random_moments_continues_to_identical_results() {
+    use deepbrdf_model::burn::config::Config as _;
+    use deepbrdf_model::{AutoencoderConfig, TrainConfig};
 
-    let trials: usize =
-        std::env::var(KILL_TRIALS_VAR).ok().and_then(|v| v.parse().ok()).unwrap_or(2);
-    let mut kills = 0;
-    for trial in 0..trials {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(trial as u64);
-        let out = dir.path().join(format!("killed-{trial}"));
-        // Up to three kills per trial at random moments over the run's length, then a run to the
-        // end (a fresh start if no checkpoint was written yet, else --resume).
-        for attempt in 0..rng.random_range(1..=3) {
-            let mut child = start(&out);
-            // The first attempt of a trial is killed a few milliseconds after its first
-            // checkpoint appears (so every trial kills a run in the middle, however fast or
-            // loaded the machine is); later ones at a random moment over the run's length.
-            let after_checkpoint = attempt == 0;
-            let delay = full.mul_f64(rng.random_range(0.05..1.1));
-            let extra = Duration::from_millis(rng.random_range(0..40));
-            let checkpoint = deepbrdf_model::train::checkpoint_path(&out);
-            let had_checkpoint = checkpoint.is_file();
-            let t = Instant::now();
-            let mut finished = false;
-            let mut seen: Option<Instant> = None;
-            loop {
-                if child.try_wait().expect("try_wait").is_some() {
-                    finished = true;
-                    break;
-                }
-                if after_checkpoint {
-                    if seen.is_none() && (had_checkpoint || checkpoint.is_file()) {
-                        seen = Some(Instant::now());
-                    }
-                    if seen.is_some_and(|at| at.elapsed() >= extra) {
-                        break;
-                    }
-                } else if t.elapsed() >= delay {
-                    break;
-                }
-                std::thread::sleep(Duration::from_millis(1));
-            }
-            if !finished {
-                child.kill().expect("SIGKILL");
-                kills += 1;
-            }
-            let _ = child.wait();
-        }
-        let o = start(&out).wait_with_output().expect("final run");
-        assert!(
-            o.status.success() || run_outputs(&out) == expected,
-            "trial {trial}: {}",
-            String::from_utf8_lossy(&o.stderr)
-        );
-        let got = run_outputs(&out);
-        for ((name, want), (_, have)) in expected.iter().zip(&got) {
-            assert!(want == have, "trial {trial}: {name} differs from the uninterrupted run's");
-        }
-        // The model loads: a table encodes through it.
-        let o = util::run_in(dir.path(), &["encode", &s(&out), &s(&data.join("m1.binary"))]);
-        assert!(o.status.success(), "trial {trial}: {}", util::stderr(&o));
-        eprintln!("kill test: trial {trial} bit-identical ({kills} SIGKILLs so far)");
-    }
-    eprintln!(
-        "kill test: {trials} trials, {kills} SIGKILLs, all bit-identical to the uninterrupted run"
-    );
-    assert!(kills > 0, "no run was actually killed");
+    let dir = tempfile::tempdir().expect("tempdir");
+    let data = util::write_data(dir.path(), 3);
+    let mut config =
+        TrainConfig::cpu(2).with_epochs(30).with_batch_size(1).with_checkpoint_seconds(0.0);
+    config.model = AutoencoderConfig::spectral(2, 3, Some(8));
+    let config_path = dir.path().join("tiny.json");
+    config.save(&config_path).expect("config");
+    let exe = env!("CARGO_BIN_EXE_experiments");
+    // The same command every time: sweep-k continues an interrupted run by itself.
+    let start = |out: &Path| {
+        let mut cmd = Command::new(exe);
+        cmd.args(["sweep-k", "--data", &s(&data), "--ks", "1,2", "--train-config"])
+            .args([s(&config_path), "--out".into(), s(out), "--fig2-material".into(), "m1".into()])
+            .args(["--measures", "mapped_mse", "--fig2-ks", "2", "-q"]);
+        spawn(cmd)
+    };
+    let outputs = |out: &Path| {
+        kill::files(
+            out,
+            &[
+                "results.csv",
+                "robustness.csv",
+                "models/fold0/k1/model/weights.bpk",
+                "models/fold0/k2/model/weights.bpk",
+                "models/fold0/k2/model/basis.f16",
+            ],
+        )
+    };
+    let job = kill::Job {
+        name: "sweep-k",
+        start: &start,
+        progress: &|out: &Path| {
+            deepbrdf_model::train::checkpoint_path(&out.join("models/fold0/k1"))
+        },
+        outputs: &outputs,
+    };
+    kill::kill_trials(&job, dir.path(), kill::trials(1), &|_| {});
 }
