@@ -19,8 +19,6 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use burn::prelude::*;
-use burn::store::ModuleRecord;
-use burn::tensor::Bytes;
 use deepbrdf_data::mapping::MedianReference;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -446,7 +444,8 @@ fn load_weights(network: Autoencoder, weights: Vec<u8>) -> Result<Autoencoder> {
     let bad = |e: burn::store::RecordError| {
         ModelError::Invalid(format!("the weights do not fit the configuration: {e}"))
     };
-    let record = ModuleRecord::from_bytes(Bytes::from_bytes_vec(weights)).map_err(bad)?;
+    let record = crate::record::float_record(weights)
+        .map_err(|e| ModelError::Invalid(format!("the weights do not fit the configuration: {e}")))?;
     network.try_load_record(record).map_err(bad)
 }
 

@@ -55,6 +55,15 @@ fn mutated_model_parts_are_refused_or_read_never_a_panic() {
     // The weights (burnpack): loaded into the network the configuration builds.
     load_weights(network.clone(), weights.clone()).unwrap();
     let focus = Focus { header: 256, header_share: 0.5 };
+    // The crashes fuzzing found (a tensor's dtype field turned into an integer type: Burn
+    // panicked inside its loader), kept as regression inputs.
+    for (name, bytes) in [
+        ("i32", &include_bytes!("testdata/fuzz/weights-dtype-i32.bpk")[..]),
+        ("u32", &include_bytes!("testdata/fuzz/weights-dtype-u32.bpk")[..]),
+    ] {
+        let err = load_weights(network.clone(), bytes.to_vec()).expect_err(name).to_string();
+        assert!(err.contains("not as floats"), "{name}: {err}");
+    }
     let t = std::time::Instant::now();
     let report = fuzz(&[weights], 22, n, focus, |b| load_weights(network.clone(), b.to_vec()));
     check("weights.bpk", &report, t);

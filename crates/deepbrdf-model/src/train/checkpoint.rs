@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use burn::module::Module;
 use burn::optim::ModuleOptimizer;
-use burn::store::{ModuleRecord, RecordError};
+use burn::store::RecordError;
 use burn::tensor::Bytes;
 use serde::{Deserialize, Serialize};
 
@@ -121,8 +121,8 @@ pub(super) fn load<M: Module>(
     }
     let record_error = |e: RecordError| ModelError::format(path, e.to_string());
     let model_bytes = c.take("model").ok_or_else(|| missing(path, "model"))?;
-    let record =
-        ModuleRecord::from_bytes(Bytes::from_bytes_vec(model_bytes)).map_err(record_error)?;
+    let record = crate::record::float_record(model_bytes)
+        .map_err(|e| ModelError::format(path, format!("the network's weights: {e}")))?;
     let model = skeleton.try_load_record(record).map_err(record_error)?;
     let optim_bytes = c.take("optimizer").ok_or_else(|| missing(path, "optimizer"))?;
     let optim = optim.from_bytes(Bytes::from_bytes_vec(optim_bytes)).map_err(record_error)?;
