@@ -6,6 +6,7 @@ mod baselines;
 mod convert;
 mod data;
 mod devices;
+mod editing;
 mod fetch_merl;
 mod kill;
 mod model;

@@ -2,6 +2,7 @@
 //! the PCA and IPCA baselines, the evaluation harness shared with DeepBRDF, and figures.
 pub mod attributes;
 pub mod baseline;
+pub mod editing;
 pub mod error;
 pub mod figures;
 pub mod harness;

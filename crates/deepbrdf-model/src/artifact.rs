@@ -452,7 +452,7 @@ fn load_weights(network: Autoencoder, weights: Vec<u8>) -> Result<Autoencoder> {
 /// `value` with every non-integer number replaced by its 10-significant-digit text, so the id
 /// survives a JSON round trip (serde_json may parse a printed f64 one unit in the last place
 /// away) while any real edit still changes it.
-fn canonical(value: serde_json::Value) -> serde_json::Value {
+pub(crate) fn canonical(value: serde_json::Value) -> serde_json::Value {
     use serde_json::Value;
     match value {
         Value::Number(n) if !(n.is_i64() || n.is_u64()) => {

@@ -55,6 +55,17 @@ pub enum Command {
     /// Estimate the 7 editable attributes (§5.1: diffuse and specular albedo RGB, GGX
     /// roughness) of materials by a Lambertian + GGX fit; CSV and table.
     Attributes(commands::attributes::Args),
+    /// Train the attribute-to-latent regressor of §5.1 (eq. 7) for a DeepBRDF model (and, with
+    /// --ipca, for IPCA coefficients at the same k).
+    TrainRegressor(commands::train_regressor::Args),
+    /// Edit a material's diffuse albedo, specular albedo or roughness (§5.1) through a model's
+    /// regressor and decoder.
+    Edit(commands::edit::Args),
+    /// Blend two materials in the DeepBRDF latent space, in IPCA coefficients and linearly
+    /// (Fig. 10): renders and tables.
+    Interpolate(commands::interpolate::Args),
+    /// The editing figures (Figs. 10, 12, 13, 14) and the measured edit suite.
+    FiguresEditing(commands::figures_editing::Args),
 }
 
 fn parse_device(s: &str) -> Result<deepbrdf_model::DeviceKind, String> {

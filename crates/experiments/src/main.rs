@@ -3,6 +3,7 @@ mod cli;
 mod commands;
 mod data_args;
 mod deep_method;
+mod editing;
 mod device_arg;
 mod latent_file;
 mod mapped_input;

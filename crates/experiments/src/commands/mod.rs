@@ -9,9 +9,12 @@ pub mod compare;
 pub mod convert;
 pub mod decode;
 pub mod devices;
+pub mod edit;
 pub mod encode;
 pub mod fetch_merl;
+pub mod figures_editing;
 pub mod info;
+pub mod interpolate;
 pub mod pack_nbrdf;
 pub mod reconstruct;
 pub mod render;
@@ -19,6 +22,7 @@ pub mod sheet;
 pub mod sweep_k;
 pub mod tabulate;
 pub mod train;
+pub mod train_regressor;
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     let progress = Bars::new(cli.quiet);
@@ -41,5 +45,9 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Sheet(args) => sheet::run(args, &progress),
         Command::Baselines(args) => baselines::run(args, &progress),
         Command::Attributes(args) => attributes::run(args, &progress),
+        Command::TrainRegressor(args) => train_regressor::run(args, &progress),
+        Command::Edit(args) => edit::run(args, &progress),
+        Command::Interpolate(args) => interpolate::run(args, &progress),
+        Command::FiguresEditing(args) => figures_editing::run(args, &progress),
     }
 }

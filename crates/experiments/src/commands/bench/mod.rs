@@ -3,6 +3,7 @@
 use deepbrdf_data::Progress;
 
 pub mod convert;
+pub mod edit;
 pub mod io;
 pub mod lookup;
 pub mod model;
@@ -34,6 +35,8 @@ pub enum What {
     /// Renderer speed: MERL lookups per second and images per second (target: a 256x256 sphere
     /// of a tabulated MERL material under sun and sky at 64 spp in < 0.5 s on 2 cores).
     Render(render::Args),
+    /// One edit of §5.1: regressor, decode and a 128-pixel preview (target: <= 0.5 s on 2 cores).
+    Edit(edit::Args),
     /// Renderer efficiency at equal noise: seconds per image, relative noise between two seeds
     /// and 1 / (noise^2 x s), per material and light (issue 16).
     RenderNoise(render_noise::Args),
@@ -48,5 +51,6 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         What::Render(a) => render::run(a, progress),
         What::RenderNoise(a) => render_noise::run(a, progress),
         What::Convert(a) => convert::run(a, progress),
+        What::Edit(a) => edit::run(a, progress),
     }
 }

@@ -1,0 +1,18 @@
+//! BRDF editing (Hu et al. 2020, §5.1): the edit a user asks for ([`request`]: set or scale the
+//! diffuse albedo, the specular albedo or the roughness of a material's 7 [`Attributes`]), and
+//! the measures of how well edits, interpolations and sweeps behave ([`measures`]: achieved vs
+//! requested change and leakage into the other attributes, uniformity of consecutive image
+//! differences, monotonicity of a sweep, physical plausibility of a decoded table). The
+//! regressor of eq. (7) that turns edited attributes into latent values is
+//! `deepbrdf_model::regressor`.
+//!
+//! [`Attributes`]: crate::attributes::Attributes
+
+pub mod measures;
+pub mod request;
+
+pub use measures::{
+    coefficient_of_variation, directional_albedo, edit_outcome, is_monotone, plausibility,
+    EditOutcome, Plausibility,
+};
+pub use request::{ColourEdit, Edit, EditedAttribute, ScalarEdit};

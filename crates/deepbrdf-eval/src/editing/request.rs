@@ -1,0 +1,138 @@
+//! An edit of a material's 7 attributes (§5.1): each of diffuse albedo, specular albedo and
+//! roughness is left alone, set, or scaled. [`Edit::apply`] checks the result (albedos in
+//! [0, 1], roughness in the attribute model's range) and names what is wrong.
+
+use crate::attributes::{Attributes, MAX_ROUGHNESS, MIN_ROUGHNESS};
+use crate::error::{EvalError, Result};
+
+/// A change of an RGB albedo.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ColourEdit {
+    /// Set to these values (each in [0, 1]).
+    Set([f64; 3]),
+    /// Multiply every channel by this (>= 0).
+    Scale(f64),
+}
+
+/// A change of the roughness.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ScalarEdit {
+    /// Set to this GGX alpha (> 0).
+    Set(f64),
+    /// Multiply by this (> 0).
+    Scale(f64),
+}
+
+/// Which attribute an edit changes (for the measures: the others should not move).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EditedAttribute {
+    Diffuse,
+    Specular,
+    Roughness,
+    /// No change (the identity edit).
+    None,
+}
+
+/// The edit of a material: `None` leaves an attribute as it is.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Edit {
+    pub diffuse: Option<ColourEdit>,
+    pub specular: Option<ColourEdit>,
+    pub roughness: Option<ScalarEdit>,
+}
+
+fn colour(name: &str, old: [f64; 3], edit: Option<ColourEdit>) -> Result<[f64; 3]> {
+    let new = match edit {
+        None => return Ok(old),
+        Some(ColourEdit::Set(v)) => v,
+        Some(ColourEdit::Scale(s)) => {
+            if !(s.is_finite() && s >= 0.0) {
+                return Err(EvalError::Invalid(format!(
+                    "{name} albedo scale {s} must be a finite number >= 0"
+                )));
+            }
+            old.map(|v| v * s)
+        }
+    };
+    for (c, v) in ["R", "G", "B"].iter().zip(new) {
+        if !(v.is_finite() && (0.0..=1.0).contains(&v)) {
+            return Err(EvalError::Invalid(format!(
+                "{name} albedo {c} = {v:.4} is outside [0, 1] (an albedo is a fraction of the \
+                 light; the material's is {:.4} {:.4} {:.4})",
+                old[0], old[1], old[2]
+            )));
+        }
+    }
+    Ok(new)
+}
+
+impl Edit {
+    /// The attribute this edit changes: the only one it touches, else `None` for the identity
+    /// edit; an edit of several attributes reports the first of diffuse, specular, roughness.
+    pub fn edited(&self) -> EditedAttribute {
+        match (self.diffuse, self.specular, self.roughness) {
+            (Some(_), _, _) => EditedAttribute::Diffuse,
+            (None, Some(_), _) => EditedAttribute::Specular,
+            (None, None, Some(_)) => EditedAttribute::Roughness,
+            (None, None, None) => EditedAttribute::None,
+        }
+    }
+
+    /// The edited attributes of `a`, checked.
+    pub fn apply(&self, a: &Attributes) -> Result<Attributes> {
+        let roughness = match self.roughness {
+            None => a.roughness,
+            Some(ScalarEdit::Set(r)) | Some(ScalarEdit::Scale(r)) if !(r.is_finite() && r > 0.0) => {
+                return Err(EvalError::Invalid(format!(
+                    "roughness {r} must be a positive number (a GGX alpha in \
+                     [{MIN_ROUGHNESS}, {MAX_ROUGHNESS}], or a scale > 0)"
+                )));
+            }
+            Some(ScalarEdit::Set(r)) => r,
+            Some(ScalarEdit::Scale(s)) => a.roughness * s,
+        };
+        if !(MIN_ROUGHNESS..=MAX_ROUGHNESS).contains(&roughness) {
+            return Err(EvalError::Invalid(format!(
+                "roughness {roughness:.4} is outside [{MIN_ROUGHNESS}, {MAX_ROUGHNESS}] (the \
+                 material's is {:.4})",
+                a.roughness
+            )));
+        }
+        let edited = Attributes {
+            diffuse: colour("diffuse", a.diffuse, self.diffuse)?,
+            specular: colour("specular", a.specular, self.specular)?,
+            roughness,
+        };
+        edited.validate()?;
+        Ok(edited)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn edits_apply_and_bad_values_are_named() {
+        let a = Attributes { diffuse: [0.4, 0.2, 0.1], specular: [0.05; 3], roughness: 0.1 };
+        let e = Edit { diffuse: Some(ColourEdit::Scale(0.5)), ..Edit::default() };
+        assert_eq!(e.apply(&a).unwrap().diffuse, [0.2, 0.1, 0.05]);
+        assert_eq!(e.edited(), EditedAttribute::Diffuse);
+        assert_eq!(Edit::default().apply(&a).unwrap(), a);
+        assert_eq!(Edit::default().edited(), EditedAttribute::None);
+        let e = Edit { roughness: Some(ScalarEdit::Scale(2.0)), ..Edit::default() };
+        assert!((e.apply(&a).unwrap().roughness - 0.2).abs() < 1e-12);
+        let cases = [
+            (Edit { diffuse: Some(ColourEdit::Scale(3.0)), ..Edit::default() }, "diffuse albedo R"),
+            (Edit { specular: Some(ColourEdit::Set([0.1, 1.5, 0.1])), ..Edit::default() }, "specular albedo G"),
+            (Edit { diffuse: Some(ColourEdit::Scale(-1.0)), ..Edit::default() }, ">= 0"),
+            (Edit { roughness: Some(ScalarEdit::Set(-0.2)), ..Edit::default() }, "positive"),
+            (Edit { roughness: Some(ScalarEdit::Scale(20.0)), ..Edit::default() }, "outside"),
+            (Edit { roughness: Some(ScalarEdit::Set(f64::NAN)), ..Edit::default() }, "roughness"),
+        ];
+        for (edit, needle) in cases {
+            let err = edit.apply(&a).unwrap_err().to_string();
+            assert!(err.contains(needle), "{needle}: {err}");
+        }
+    }
+}

@@ -1,0 +1,110 @@
+//! `experiments bench edit [--model DIR] [MATERIAL] [edit options]`: the time of one edit of
+//! §5.1 (target: <= 0.5 s on 2 cores), split into the regressor (eq. 7, twice for the residual
+//! edit), the decode (eq. 3) and a 128-pixel preview render (sphere, sun and sky, 16 spp); the
+//! attribute fit and the encode of the material, done once when it is picked, are timed apart.
+use crate::commands::edit::EditArgs;
+use crate::data_args::CacheArg;
+use crate::editing::{self, EditMode, ModelCodec, Space, DEFAULT_MODE};
+use crate::model_arg::ModelArg;
+use anyhow::Context;
+use deepbrdf_data::dataset::load_material;
+use deepbrdf_data::{Progress, Silent};
+use deepbrdf_eval::attributes::FitConfig;
+use deepbrdf_eval::editing::{Edit, ScalarEdit};
+use deepbrdf_eval::harness::Codec;
+use deepbrdf_eval::metrics::ImageRelaeConfig;
+use deepbrdf_render::{render, MerlBrdf};
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    pub model: ModelArg,
+    /// The regressor folder [default: <model>/regressor].
+    #[arg(long, value_name = "DIR")]
+    pub regressor: Option<PathBuf>,
+    /// The material to edit.
+    #[arg(default_value = "red-plastic")]
+    pub material: String,
+    #[command(flatten)]
+    pub edit: EditArgs,
+    #[arg(long, value_enum)]
+    pub mode: Option<EditMode>,
+    /// Timed edits (after one warm-up).
+    #[arg(long, default_value_t = 5)]
+    pub reps: usize,
+    #[command(flatten)]
+    pub cache: CacheArg,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
+    let device = crate::device_arg::device()?;
+    let model_dir = args.model.dir()?;
+    let t = Instant::now();
+    let (model, regressor) = editing::load_editor(&model_dir, args.regressor.as_deref(), &device)?;
+    let load = t.elapsed().as_secs_f64();
+    let (name, table) = load_material(&args.material, &args.cache.cache())
+        .with_context(|| format!("loading material '{}'", args.material))?;
+    let t = Instant::now();
+    let original = editing::attributes_of(&table, &name, &FitConfig::default())?;
+    let fit = t.elapsed().as_secs_f64();
+    let codec = ModelCodec(&model);
+    let t = Instant::now();
+    let latent = codec.encode(&table)?;
+    let encode = t.elapsed().as_secs_f64();
+    let mut edit = args.edit.edit()?;
+    if edit == Edit::default() {
+        edit.roughness = Some(ScalarEdit::Scale(2.0));
+    }
+    let mode = args.mode.unwrap_or(DEFAULT_MODE);
+    let space = Space { codec: &codec, regressor: &regressor };
+    let preview = ImageRelaeConfig::default();
+    let scene = preview.scene.build()?;
+    let (mut reg, mut dec, mut ren, mut all) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for rep in 0..=args.reps.max(1) {
+        let t0 = Instant::now();
+        let requested = edit.apply(&original)?;
+        let target = space.latent_of(&requested)?;
+        let z: Vec<f32> = match mode {
+            EditMode::Paper => target,
+            EditMode::Residual => {
+                let base = space.latent_of(&original)?;
+                latent.iter().zip(target.iter().zip(&base)).map(|(y, (t, b))| y + t - b).collect()
+            }
+        };
+        let t1 = Instant::now();
+        let edited = codec.decode(&z)?;
+        let t2 = Instant::now();
+        let _image = render(&scene, &MerlBrdf::new(&edited), &preview.render, &Silent)?;
+        let t3 = Instant::now();
+        if rep > 0 {
+            reg.push((t1 - t0).as_secs_f64());
+            dec.push((t2 - t1).as_secs_f64());
+            ren.push((t3 - t2).as_secs_f64());
+            all.push((t3 - t0).as_secs_f64());
+        }
+    }
+    println!(
+        "{name}, {} edit, model {} (k = {}), {} threads; medians of {} edits",
+        mode.name(),
+        model.id(),
+        model.k(),
+        rayon::current_num_threads(),
+        all.len()
+    );
+    println!(
+        "one edit: {:.3} s (target <= 0.5 s): regressor {:.5} s, decode {:.3} s, 128 px preview {:.3} s",
+        median(all),
+        median(reg),
+        median(dec),
+        median(ren)
+    );
+    println!("once per material: attribute fit {fit:.3} s, encode {encode:.3} s; loading model and regressor {load:.2} s");
+    Ok(())
+}

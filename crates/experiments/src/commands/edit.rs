@@ -1,0 +1,151 @@
+//! `experiments edit [--model DIR] MATERIAL [--diffuse R,G,B | --diffuse-scale X] [--specular
+//! R,G,B | --specular-scale X] [--roughness X | --roughness-scale X] [--mode paper|residual]
+//! -o edited.binary [--render edited.png]`: edits a material's diffuse albedo, specular albedo or
+//! roughness (§5.1) through the model's regressor (eq. 7) and decoder (eq. 3), writes the
+//! edited MERL table, and prints the attributes asked for and those re-estimated on the result.
+use crate::data_args::CacheArg;
+use crate::editing::{self, EditMode, ModelCodec, Space, DEFAULT_MODE};
+use crate::model_arg::ModelArg;
+use crate::scene_args::SceneArgs;
+use anyhow::{bail, Context};
+use deepbrdf_data::dataset::load_material;
+use deepbrdf_data::merl::write_merl;
+use deepbrdf_data::Progress;
+use deepbrdf_eval::attributes::{Attributes, FitConfig};
+use deepbrdf_eval::editing::{ColourEdit, Edit, ScalarEdit};
+use deepbrdf_render::{render, MerlBrdf};
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    pub model: ModelArg,
+    /// The regressor folder [default: <model>/regressor].
+    #[arg(long, value_name = "DIR")]
+    pub regressor: Option<PathBuf>,
+    /// A MERL .binary file or a bundled material.
+    pub material: String,
+    #[command(flatten)]
+    pub edit: EditArgs,
+    /// paper: Y' = Phi(alpha'); residual: Y' = Y + Phi(alpha') - Phi(alpha) [default: residual].
+    #[arg(long, value_enum)]
+    pub mode: Option<EditMode>,
+    /// Output MERL .binary file.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+    /// Also render the edited material to this PNG (with the scene options).
+    #[arg(long, value_name = "PNG")]
+    pub render: Option<PathBuf>,
+    /// Replace existing output files.
+    #[arg(long)]
+    pub force: bool,
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub cache: CacheArg,
+}
+
+/// The attribute changes of `edit` (shared with `bench edit`).
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct EditArgs {
+    /// Set the diffuse albedo (each in [0, 1]).
+    #[arg(long, value_name = "R,G,B", conflicts_with = "diffuse_scale")]
+    pub diffuse: Option<String>,
+    /// Multiply the diffuse albedo.
+    #[arg(long, value_name = "X")]
+    pub diffuse_scale: Option<f64>,
+    /// Set the specular albedo (each in [0, 1]).
+    #[arg(long, value_name = "R,G,B", conflicts_with = "specular_scale")]
+    pub specular: Option<String>,
+    /// Multiply the specular albedo.
+    #[arg(long, value_name = "X")]
+    pub specular_scale: Option<f64>,
+    /// Set the roughness (GGX alpha, > 0).
+    #[arg(long, value_name = "X", conflicts_with = "roughness_scale", allow_hyphen_values = true)]
+    pub roughness: Option<f64>,
+    /// Multiply the roughness.
+    #[arg(long, value_name = "X", allow_hyphen_values = true)]
+    pub roughness_scale: Option<f64>,
+}
+
+fn rgb(flag: &str, text: &str) -> anyhow::Result<[f64; 3]> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let values: Option<Vec<f64>> = parts.iter().map(|p| p.parse::<f64>().ok()).collect();
+    match values {
+        Some(v) if v.len() == 3 => Ok([v[0], v[1], v[2]]),
+        _ => bail!("--{flag} '{text}': expected three numbers R,G,B"),
+    }
+}
+
+impl EditArgs {
+    /// The edit these arguments ask for (values are checked when it is applied).
+    pub fn edit(&self) -> anyhow::Result<Edit> {
+        let colour = |flag: &str, set: &Option<String>, scale: Option<f64>| {
+            anyhow::Ok(match (set, scale) {
+                (Some(text), _) => Some(ColourEdit::Set(rgb(flag, text)?)),
+                (None, Some(s)) => Some(ColourEdit::Scale(s)),
+                (None, None) => None,
+            })
+        };
+        Ok(Edit {
+            diffuse: colour("diffuse", &self.diffuse, self.diffuse_scale)?,
+            specular: colour("specular", &self.specular, self.specular_scale)?,
+            roughness: match (self.roughness, self.roughness_scale) {
+                (Some(r), _) => Some(ScalarEdit::Set(r)),
+                (None, Some(s)) => Some(ScalarEdit::Scale(s)),
+                (None, None) => None,
+            },
+        })
+    }
+}
+
+/// `diffuse 0.123 0.456 0.789, specular ..., roughness ...`.
+pub fn describe(a: &Attributes) -> String {
+    let (d, s) = (a.diffuse, a.specular);
+    format!(
+        "diffuse {:.4} {:.4} {:.4}, specular {:.4} {:.4} {:.4}, roughness {:.4}",
+        d[0], d[1], d[2], s[0], s[1], s[2], a.roughness
+    )
+}
+
+pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
+    let edit = args.edit.edit()?;
+    for path in std::iter::once(&args.output).chain(args.render.as_ref()) {
+        if path.exists() && !args.force {
+            bail!("{} exists; pass --force to replace it", path.display());
+        }
+    }
+    let setup = args.render.as_ref().map(|_| args.scene.setup(256)).transpose()?;
+    let started = Instant::now();
+    let (name, table) = load_material(&args.material, &args.cache.cache())
+        .with_context(|| format!("loading material '{}'", args.material))?;
+    let fit = FitConfig::default();
+    let original = editing::attributes_of(&table, &name, &fit)?;
+    // Checked before the model loads: a bad value fails at once.
+    edit.apply(&original).with_context(|| format!("editing {name}"))?;
+    let device = crate::device_arg::device()?;
+    let model_dir = args.model.dir()?;
+    let (model, regressor) = editing::load_editor(&model_dir, args.regressor.as_deref(), &device)?;
+    let codec = ModelCodec(&model);
+    let space = Space { codec: &codec, regressor: &regressor };
+    let mode = args.mode.unwrap_or(DEFAULT_MODE);
+    let latent = match mode {
+        EditMode::Residual => model.encode(&table)?,
+        EditMode::Paper => Vec::new(),
+    };
+    let edited = space.edit(&latent, &original, &edit, mode)?;
+    write_merl(&edited.table, &args.output)?;
+    let achieved = editing::attributes_of(&edited.table, "the edited table", &fit)?;
+    println!("{name} (model {}, {} edit)", model.id(), mode.name());
+    println!("  original  {}", describe(&original));
+    println!("  requested {}", describe(&edited.requested));
+    println!("  achieved  {} (re-estimated on the result)", describe(&achieved));
+    if let (Some(png), Some(setup)) = (&args.render, &setup) {
+        let image = render(&setup.scene, &MerlBrdf::new(&edited.table), &setup.settings, progress)?;
+        image.write_png(png, &setup.tonemap)?;
+        println!("  rendered {} -> {}", setup.description(), png.display());
+    }
+    println!("wrote {} in {:.2} s", args.output.display(), started.elapsed().as_secs_f64());
+    Ok(())
+}

@@ -1,0 +1,387 @@
+//! `experiments figures-editing [--model DIR] [--out results/editing] [--every N]`: the
+//! editing figures of §5.1 as PNG strips and the measured suite of issue 11, in-sample (the
+//! model and the regressors saw every material).
+//!
+//! - Fig. 10: red-metallic-paint to red-fabric in 9 steps, DeepBRDF latent vs IPCA coefficients
+//!   vs a linear blend of the tables.
+//! - Fig. 12: the diffuse albedo of gray-plastic set to several colours.
+//! - Fig. 13: the roughness of red-plastic swept from x1/4 to x4.
+//! - Fig. 14: the same sweep of specular-yellow-phenolic, DeepBRDF vs IPCA.
+//! - The suite, on every N-th material: diffuse albedo x0.5 and a hue change (its channels
+//!   rotated), specular albedo x0.5, roughness x0.5 and x2, and the identity edit, for DeepBRDF
+//!   and IPCA (at the model's k), paper and residual edits: the attributes re-estimated on each
+//!   decoded table against the requested ones (target error, change ratio, drift of the
+//!   untouched attributes), the identity edit's image RelAE against the original, the
+//!   plausibility of every decoded table; and the monotonicity of the re-estimated roughness
+//!   along each Fig. 13/14 sweep.
+//!
+//! Writes `results.md` (the tables), `suite.csv` (every material and edit) and the figures.
+use super::interpolate::{self, Path3};
+use super::train_regressor::{self, IPCA_BASIS_FILE};
+use crate::data_args::DataArgs;
+use crate::editing::{self, ipca_owner_id, EditMode, ModelCodec, Space};
+use crate::model_arg::ModelArg;
+use anyhow::Context;
+use deepbrdf_data::{MerlTable, Progress};
+use deepbrdf_eval::attributes::{Attributes, FitConfig};
+use deepbrdf_eval::baseline::{BaselineBasis, MappingKind};
+use deepbrdf_eval::editing::{
+    edit_outcome, is_monotone, plausibility, ColourEdit, Edit, EditOutcome, ScalarEdit,
+};
+use deepbrdf_eval::harness::Codec;
+use deepbrdf_eval::metrics::{ImageRelae, ImageRelaeConfig};
+use deepbrdf_model::regressor::{Regressor, RegressorData, Target, TargetKind};
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    pub model: ModelArg,
+    /// The regressor folder [default: <model>/regressor].
+    #[arg(long, value_name = "DIR")]
+    pub regressor: Option<PathBuf>,
+    /// Output folder.
+    #[arg(long, value_name = "DIR", default_value = "results/editing")]
+    pub out: PathBuf,
+    /// Run the suite on every N-th material of the dataset (1: all).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..))]
+    pub every: u32,
+    /// Epochs of the IPCA regressor when none is saved [default: the library's].
+    #[arg(long)]
+    pub epochs: Option<usize>,
+    /// Skip the figures (suite only).
+    #[arg(long)]
+    pub no_figures: bool,
+    #[command(flatten)]
+    pub data: DataArgs,
+}
+
+/// The suite's edits: name and edit of a material's attributes.
+fn suite_edits(a: &Attributes) -> Vec<(&'static str, Edit)> {
+    let d = a.diffuse;
+    vec![
+        ("identity", Edit::default()),
+        ("diffuse x0.5", Edit { diffuse: Some(ColourEdit::Scale(0.5)), ..Edit::default() }),
+        ("diffuse hue", Edit { diffuse: Some(ColourEdit::Set([d[2], d[0], d[1]])), ..Edit::default() }),
+        ("specular x0.5", Edit { specular: Some(ColourEdit::Scale(0.5)), ..Edit::default() }),
+        ("roughness x0.5", Edit { roughness: Some(ScalarEdit::Scale(0.5)), ..Edit::default() }),
+        ("roughness x2", Edit { roughness: Some(ScalarEdit::Scale(2.0)), ..Edit::default() }),
+    ]
+}
+
+/// The roughness scales of the Fig. 13/14 sweeps.
+const SWEEP: [f64; 7] = [0.25, 0.397, 0.63, 1.0, 1.587, 2.52, 4.0];
+
+/// One row of the suite.
+struct SuiteRow {
+    material: String,
+    method: &'static str,
+    mode: EditMode,
+    edit: &'static str,
+    outcome: EditOutcome,
+    identity_relae: f64,
+    plausible: bool,
+    max_albedo: f64,
+}
+
+/// A representation with its regressor, and the latent of each material under it.
+struct Rep<'a> {
+    name: &'static str,
+    space: Space<'a>,
+}
+
+fn mean(v: impl Iterator<Item = f64>) -> f64 {
+    let v: Vec<f64> = v.filter(|x| x.is_finite()).collect();
+    v.iter().sum::<f64>() / v.len().max(1) as f64
+}
+
+fn median(v: impl Iterator<Item = f64>) -> f64 {
+    let mut v: Vec<f64> = v.filter(|x| x.is_finite()).collect();
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+/// A sweep of `edits` on one material for one representation and mode: its tables.
+fn sweep(
+    rep: &Rep,
+    table: &MerlTable,
+    original: &Attributes,
+    edits: &[Edit],
+    mode: EditMode,
+) -> anyhow::Result<Vec<MerlTable>> {
+    let latent = rep.space.codec.encode(table)?;
+    edits.iter().map(|e| Ok(rep.space.edit(&latent, original, e, mode)?.table)).collect()
+}
+
+pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
+    let started = Instant::now();
+    let model_dir = args.model.dir()?;
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    let device = crate::device_arg::device()?;
+    let (model, deep_regressor) =
+        editing::load_editor(&model_dir, args.regressor.as_deref(), &device)?;
+    let k = model.k();
+    let set = args.data.load(progress)?;
+    let fit = FitConfig::default();
+    progress.start(set.len() as u64, "attributes");
+    let mut attrs = Vec::new();
+    for (name, t) in set.names.iter().zip(&set.tables) {
+        attrs.push(editing::attributes_of(t, name, &fit)?);
+        progress.advance(1);
+    }
+    progress.finish();
+
+    // IPCA at the same k, with its regressor (saved by `train-regressor --ipca`, else trained
+    // here on the same materials).
+    let reg_dir = editing::regressor_dir(&model_dir, args.regressor.as_deref());
+    let saved_basis = reg_dir.join(IPCA_BASIS_FILE);
+    let basis = Arc::new(match saved_basis.exists() {
+        true => BaselineBasis::load(&saved_basis)?,
+        false => {
+            let refs: Vec<_> = set.tables.iter().collect();
+            BaselineBasis::fit("IPCA", MappingKind::LogRelative, &refs, k, progress)?
+        }
+    });
+    let ipca = basis.codec(k)?;
+    let owner = ipca_owner_id(&basis, k);
+    let ipca_regressor = match Regressor::load_for(&reg_dir, TargetKind::Ipca, &owner, k, &device) {
+        Ok(r) => r,
+        Err(_) => {
+            let targets = set.tables.iter().map(|t| ipca.encode(t)).collect::<deepbrdf_eval::Result<Vec<_>>>()?;
+            let data = RegressorData {
+                label: set.label.clone(),
+                names: set.names.clone(),
+                attributes: attrs.iter().map(Attributes::to_array).collect(),
+                targets,
+            };
+            let config = train_regressor::config(args.epochs, 0);
+            let target = Target { kind: TargetKind::Ipca, owner_id: owner, k };
+            let scratch = args.out.join("ipca-regressor");
+            train_regressor::train_into(&scratch, &data, &config, target, progress, &device)?
+        }
+    };
+    let deep_codec = ModelCodec(&model);
+    let deep = Rep { name: "DeepBRDF", space: Space { codec: &deep_codec, regressor: &deep_regressor } };
+    let ipca_rep = Rep { name: "IPCA", space: Space { codec: &ipca, regressor: &ipca_regressor } };
+    let reps = [&deep, &ipca_rep];
+    let index = |name: &str| {
+        set.names.iter().position(|n| n == name).with_context(|| format!("{name} is not in {}", set.label))
+    };
+    let mut md = format!(
+        "# Editing (§5.1): figures and measured suite\n\nWritten by `experiments figures-editing` (model {}, k = {k}, {} materials of {}; in-sample: the autoencoder and both regressors were trained on every material).\n\n",
+        model.id(),
+        set.len(),
+        set.label
+    );
+
+    let mut sweeps_md = String::new();
+    if !args.no_figures {
+        // Fig. 10.
+        let (a, b) = (index("red-metallic-paint")?, index("red-fabric")?);
+        let paths = interpolate::paths(&model, Some(&ipca), &set.tables[a], &set.tables[b], 9, progress)?;
+        let refs: Vec<&Path3> = paths.iter().collect();
+        interpolate::strip(&refs, &|row, i| format!("{} t={:.3}", paths[row].name, i as f64 / 8.0))?
+            .write_png(&args.out.join("fig10_interpolation.png"))?;
+        md += "## Fig. 10: red-metallic-paint to red-fabric, 9 steps\n\n![Fig. 10](fig10_interpolation.png)\n\nImage RelAE between consecutive steps (128 px sphere, sun and sky, 16 spp):\n\n";
+        md += &interpolate::summary(&paths)?;
+
+        // Fig. 12: diffuse colours of gray-plastic.
+        let g = index("gray-plastic")?;
+        let colours: [(&str, [f64; 3]); 6] = [
+            ("red", [0.5, 0.05, 0.05]),
+            ("orange", [0.5, 0.25, 0.03]),
+            ("green", [0.08, 0.4, 0.08]),
+            ("blue", [0.05, 0.1, 0.5]),
+            ("white", [0.7, 0.7, 0.7]),
+            ("black", [0.01, 0.01, 0.01]),
+        ];
+        let edits: Vec<Edit> = colours
+            .iter()
+            .map(|(_, c)| Edit { diffuse: Some(ColourEdit::Set(*c)), ..Edit::default() })
+            .collect();
+        let reference = ImageRelae::new(&set.tables[g], &ImageRelaeConfig::default())?;
+        let mut rows = Vec::new();
+        for mode in [EditMode::Paper, EditMode::Residual] {
+            let mut tables = vec![set.tables[g].clone()];
+            tables.extend(sweep(&deep, &set.tables[g], &attrs[g], &edits, mode)?);
+            let images = interpolate::render_all(&reference, &tables)?;
+            rows.push(Path3 { name: format!("DeepBRDF {}", mode.name()), tables, images });
+        }
+        let refs: Vec<&Path3> = rows.iter().collect();
+        interpolate::strip(&refs, &|row, i| match i {
+            0 => "original".into(),
+            _ => format!("{} {}", rows[row].name.trim_start_matches("DeepBRDF "), colours[i - 1].0),
+        })?
+        .write_png(&args.out.join("fig12_diffuse.png"))?;
+        md += "\n## Fig. 12: diffuse albedo of gray-plastic\n\n![Fig. 12](fig12_diffuse.png)\n\nRows: the paper's edit, the residual edit; first column the measurement. Requested vs re-estimated diffuse albedo:\n\n| edit | requested | paper: achieved | residual: achieved |\n| --- | --- | --- | --- |\n";
+        for (i, (name, c)) in colours.iter().enumerate() {
+            let got: Vec<String> = rows
+                .iter()
+                .map(|r| {
+                    let a = editing::attributes_of(&r.tables[i + 1], name, &fit)?;
+                    anyhow::Ok(format!("{:.3} {:.3} {:.3}", a.diffuse[0], a.diffuse[1], a.diffuse[2]))
+                })
+                .collect::<anyhow::Result<_>>()?;
+            let _ = writeln!(md, "| {name} | {:.3} {:.3} {:.3} | {} | {} |", c[0], c[1], c[2], got[0], got[1]);
+        }
+
+        // Figs. 13 and 14: roughness sweeps.
+        let sweep_edits: Vec<Edit> = SWEEP
+            .iter()
+            .map(|s| Edit { roughness: Some(ScalarEdit::Scale(*s)), ..Edit::default() })
+            .collect();
+        sweeps_md += "\n## Roughness sweeps (Figs. 13, 14): re-estimated roughness along x1/4 ... x4\n\n| material | representation | edit | requested | re-estimated | monotone |\n| --- | --- | --- | --- | --- | --- |\n";
+        for (fig, material, methods) in [
+            ("fig13_roughness", "red-plastic", vec![&deep]),
+            ("fig14_roughness", "specular-yellow-phenolic", vec![&deep, &ipca_rep]),
+        ] {
+            let m = index(material)?;
+            let a = &attrs[m];
+            let usable: Vec<(f64, Edit)> = SWEEP
+                .iter()
+                .copied()
+                .zip(sweep_edits.iter().copied())
+                .filter(|(_, e)| e.apply(a).is_ok())
+                .collect();
+            let edits: Vec<Edit> = usable.iter().map(|(_, e)| *e).collect();
+            let reference = ImageRelae::new(&set.tables[m], &ImageRelaeConfig::default())?;
+            let mut rows = Vec::new();
+            for rep in &methods {
+                for mode in [EditMode::Paper, EditMode::Residual] {
+                    let tables = sweep(rep, &set.tables[m], a, &edits, mode)?;
+                    let got: Vec<f64> = tables
+                        .iter()
+                        .map(|t| Ok(editing::attributes_of(t, material, &fit)?.roughness))
+                        .collect::<anyhow::Result<_>>()?;
+                    let requested: Vec<String> = usable.iter().map(|(s, _)| format!("{:.3}", a.roughness * s)).collect();
+                    let shown: Vec<String> = got.iter().map(|r| format!("{r:.3}")).collect();
+                    let _ = writeln!(
+                        sweeps_md,
+                        "| {material} | {} | {} | {} | {} | {} |",
+                        rep.name,
+                        mode.name(),
+                        requested.join(" "),
+                        shown.join(" "),
+                        if is_monotone(&got, true, 0.0) { "yes" } else { "no" }
+                    );
+                    let images = interpolate::render_all(&reference, &tables)?;
+                    rows.push(Path3 { name: format!("{} {}", rep.name, mode.name()), tables, images });
+                }
+            }
+            let refs: Vec<&Path3> = rows.iter().collect();
+            interpolate::strip(&refs, &|row, i| format!("{} x{:.2}", rows[row].name, usable[i].0))?
+                .write_png(&args.out.join(format!("{fig}.png")))?;
+            let _ = write!(
+                md,
+                "\n## {}: roughness of {material}\n\n![{fig}]({fig}.png)\n\nRows: {}; columns: roughness x{}.\n",
+                if fig.starts_with("fig13") { "Fig. 13" } else { "Fig. 14" },
+                rows.iter().map(|r| r.name.as_str()).collect::<Vec<_>>().join(", "),
+                usable.iter().map(|(s, _)| format!("{s:.2}")).collect::<Vec<_>>().join(", x")
+            );
+        }
+    }
+
+    // The suite.
+    let chosen: Vec<usize> = (0..set.len()).step_by(args.every as usize).collect();
+    let quick = editing::quick_fit();
+    let mut rows: Vec<SuiteRow> = Vec::new();
+    progress.start(chosen.len() as u64, "edit suite");
+    for &m in &chosen {
+        let (name, table, original) = (&set.names[m], &set.tables[m], &attrs[m]);
+        let reference = ImageRelae::new(table, &ImageRelaeConfig::default())?;
+        for rep in reps {
+            let latent = rep.space.codec.encode(table)?;
+            for mode in [EditMode::Paper, EditMode::Residual] {
+                for (edit_name, edit) in suite_edits(original) {
+                    let Ok(edited) = rep.space.edit(&latent, original, &edit, mode) else {
+                        continue; // an edit out of range for this material (e.g. x2 past alpha 1)
+                    };
+                    let achieved = editing::attributes_of(&edited.table, name, &quick)?;
+                    let outcome = edit_outcome(original, &edited.requested, &achieved, edit.edited());
+                    let identity_relae = match edit_name {
+                        "identity" => reference.measure(&edited.table)?,
+                        _ => f64::NAN,
+                    };
+                    let p = plausibility(&edited.table);
+                    rows.push(SuiteRow {
+                        material: name.clone(),
+                        method: rep.name,
+                        mode,
+                        edit: edit_name,
+                        outcome,
+                        identity_relae,
+                        plausible: p.is_plausible(),
+                        max_albedo: p.max_albedo,
+                    });
+                }
+            }
+        }
+        progress.advance(1);
+    }
+    progress.finish();
+    let mut csv = String::from("material,method,mode,edit,target_error,change_ratio,diffuse_drift,specular_drift,roughness_drift,identity_relae,plausible,max_albedo\n");
+    for r in &rows {
+        let o = r.outcome;
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{},{:.6}",
+            r.material, r.method, r.mode.name(), r.edit, o.target_error, o.change_ratio,
+            o.diffuse_drift, o.specular_drift, o.roughness_drift, r.identity_relae, r.plausible, r.max_albedo
+        );
+    }
+    deepbrdf_data::files::write_atomic(&args.out.join("suite.csv"), csv.as_bytes())?;
+    let _ = write!(
+        md,
+        "\n## Edit suite ({} materials: every {}-th of {}; attributes re-estimated with the fit on a quarter of its cells)\n\nMedians over the materials (means in `suite.csv`' rows): target error `|achieved - requested| / |requested|` of the edited attribute, change ratio (achieved change over requested change, 1 = as asked), relative drift of the untouched attributes, share of materials whose edit is within 10% of the target with less than 10% drift of every other attribute; identity edit: image RelAE against the measurement; plausible: no negative value and directional albedo <= 1 at 0-85 degrees.\n\n| representation | edit | mode | target error | change ratio | diffuse drift | specular drift | roughness drift | within 10% / drift < 10% | identity image RelAE | plausible |\n| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n",
+        chosen.len(),
+        args.every,
+        set.len()
+    );
+    for method in ["DeepBRDF", "IPCA"] {
+        for (edit_name, _) in suite_edits(&attrs[0]) {
+            for mode in [EditMode::Paper, EditMode::Residual] {
+                let sel: Vec<&SuiteRow> = rows
+                    .iter()
+                    .filter(|r| r.method == method && r.edit == edit_name && r.mode == mode)
+                    .collect();
+                if sel.is_empty() {
+                    continue;
+                }
+                let f = |g: fn(&EditOutcome) -> f64| median(sel.iter().map(|r| g(&r.outcome)));
+                let good = sel
+                    .iter()
+                    .filter(|r| {
+                        let o = r.outcome;
+                        let drifts = [o.diffuse_drift, o.specular_drift, o.roughness_drift];
+                        let target_ok = o.target_error.is_nan() || o.target_error < 0.1;
+                        target_ok && drifts.iter().all(|d| d.is_nan() || *d < 0.1)
+                    })
+                    .count();
+                let plausible = sel.iter().filter(|r| r.plausible).count();
+                let show = |v: f64| if v.is_finite() { format!("{v:.3}") } else { "-".into() };
+                let _ = writeln!(
+                    md,
+                    "| {method} | {edit_name} | {} | {} | {} | {} | {} | {} | {good}/{} | {} | {plausible}/{} |",
+                    mode.name(),
+                    show(f(|o| o.target_error)),
+                    show(f(|o| o.change_ratio)),
+                    show(f(|o| o.diffuse_drift)),
+                    show(f(|o| o.specular_drift)),
+                    show(f(|o| o.roughness_drift)),
+                    sel.len(),
+                    show(mean(sel.iter().map(|r| r.identity_relae))),
+                    sel.len()
+                );
+            }
+        }
+    }
+    md += &sweeps_md;
+    let _ = write!(md, "\nWhole command {:.0} s.\n", started.elapsed().as_secs_f64());
+    deepbrdf_data::files::write_atomic(&args.out.join("results.md"), md.as_bytes())?;
+    println!("{md}");
+    println!("wrote {}", args.out.display());
+    Ok(())
+}

@@ -1,0 +1,149 @@
+//! `experiments train-regressor [--model DIR] [--collection NAME | --data DIR] [--out DIR]
+//! [--ipca]`: trains the attribute-to-latent regressor of §5.1 (eq. (7), Fig. 11) for a DeepBRDF
+//! model: the 7 attributes of each material (the Lambertian + GGX fit,
+//! `deepbrdf_eval::attributes`) to its latent values under the model (eq. 2), through the shared
+//! training loop; saved as `<out>/deepbrdf.regressor` (default out: `<model>/regressor/`), naming
+//! the model. With `--ipca`, also an IPCA basis at the same k (`ipca.basis`) and the regressor of
+//! its coefficients (`ipca.regressor`), for the paper's Fig. 14 comparison.
+use crate::data_args::DataArgs;
+use crate::editing::{self, ipca_owner_id};
+use crate::model_arg::ModelArg;
+use anyhow::{bail, Context};
+use deepbrdf_data::Progress;
+use deepbrdf_eval::attributes::FitConfig;
+use deepbrdf_eval::baseline::{BaselineBasis, MappingKind};
+use deepbrdf_model::burn::tensor::Device;
+use deepbrdf_model::regressor::{
+    train_regressor, Regressor, RegressorConfig, RegressorData, Target, TargetKind,
+};
+use deepbrdf_model::train::Session;
+use deepbrdf_model::DeepBrdf;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// File name of the IPCA basis trained beside an IPCA regressor.
+pub const IPCA_BASIS_FILE: &str = "ipca.basis";
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    pub model: ModelArg,
+    /// Output folder [default: <model>/regressor].
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Also fit IPCA at the model's k on the same materials and train a regressor of its
+    /// coefficients.
+    #[arg(long)]
+    pub ipca: bool,
+    /// Epochs [default: the library's, 3000].
+    #[arg(long)]
+    pub epochs: Option<usize>,
+    /// Seed of the initialisation and the batch order.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Replace regressors already in the output folder.
+    #[arg(long)]
+    pub force: bool,
+    #[command(flatten)]
+    pub data: DataArgs,
+}
+
+/// The regressor's settings for these arguments.
+pub fn config(epochs: Option<usize>, seed: u64) -> RegressorConfig {
+    let mut c = RegressorConfig::default();
+    if let Some(e) = epochs {
+        c.training = c.training.with_epochs(e);
+    }
+    c.training = c.training.with_seed(seed);
+    c
+}
+
+/// Trains one regressor in `out` (its run folder `out/runs/<kind>`, resumable) and saves it.
+pub fn train_into(
+    out: &Path,
+    data: &RegressorData,
+    config: &RegressorConfig,
+    target: Target,
+    progress: &dyn Progress,
+    device: &Device,
+) -> anyhow::Result<Regressor> {
+    let kind = target.kind;
+    let name = match kind {
+        TargetKind::DeepBrdf => "deepbrdf",
+        TargetKind::Ipca => "ipca",
+    };
+    let run_dir = out.join("runs").join(name);
+    let session = Session::new(&run_dir, true, progress, &format!("regressor ({name})"));
+    let regressor = train_regressor(data, config, target, &session, device)
+        .with_context(|| format!("training the {name} regressor in {}", run_dir.display()))?;
+    let path = out.join(kind.file_name());
+    regressor.save(&path)?;
+    println!(
+        "{kind} regressor: {} materials, {} epochs in {:.1} s, training relative error \
+         ||Y^-Y||/||Y|| {:.4} (in-sample) -> {}",
+        data.names.len(),
+        regressor.provenance().epochs,
+        regressor.provenance().train_seconds,
+        regressor.provenance().train_relative_error,
+        path.display()
+    );
+    Ok(regressor)
+}
+
+pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
+    let started = Instant::now();
+    let model_dir = args.model.dir()?;
+    let out = args.out.clone().unwrap_or_else(|| editing::regressor_dir(&model_dir, None));
+    for kind in [TargetKind::DeepBrdf, TargetKind::Ipca] {
+        let path = out.join(kind.file_name());
+        if path.exists() && !args.force && (kind == TargetKind::DeepBrdf || args.ipca) {
+            bail!("{} exists; pass --force to replace it", path.display());
+        }
+    }
+    if args.force && out.join("runs").exists() {
+        std::fs::remove_dir_all(out.join("runs"))
+            .with_context(|| format!("removing the old runs in {}", out.display()))?;
+    }
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let device = crate::device_arg::device()?;
+    let model = DeepBrdf::load(&model_dir, &device)
+        .with_context(|| format!("loading the model {}", model_dir.display()))?;
+    let set = args.data.load(progress)?;
+    let fit = FitConfig::default();
+    progress.start(set.len() as u64, "attributes and latents");
+    let mut attributes = Vec::with_capacity(set.len());
+    let mut latents = Vec::with_capacity(set.len());
+    for (name, table) in set.names.iter().zip(&set.tables) {
+        attributes.push(editing::attributes_of(table, name, &fit)?.to_array());
+        latents.push(model.encode(table).with_context(|| format!("encoding {name}"))?);
+        progress.advance(1);
+    }
+    progress.finish();
+    let config = config(args.epochs, args.seed);
+    let data = RegressorData {
+        label: set.label.clone(),
+        names: set.names.clone(),
+        attributes: attributes.clone(),
+        targets: latents,
+    };
+    let target =
+        Target { kind: TargetKind::DeepBrdf, owner_id: model.id().to_string(), k: model.k() };
+    train_into(&out, &data, &config, target, progress, &device)?;
+    if args.ipca {
+        let k = model.k();
+        drop(model);
+        let refs: Vec<_> = set.tables.iter().collect();
+        let basis = BaselineBasis::fit("IPCA", MappingKind::LogRelative, &refs, k, progress)?;
+        basis.save(&out.join(IPCA_BASIS_FILE))?;
+        let coefficients = set
+            .tables
+            .iter()
+            .map(|t| basis.encode(t, k))
+            .collect::<deepbrdf_eval::Result<Vec<_>>>()?;
+        let data = RegressorData { targets: coefficients, ..data };
+        let target = Target { kind: TargetKind::Ipca, owner_id: ipca_owner_id(&basis, k), k };
+        train_into(&out, &data, &config, target, progress, &device)?;
+    }
+    println!("whole command {:.1} s", started.elapsed().as_secs_f64());
+    Ok(())
+}
