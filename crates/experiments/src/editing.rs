@@ -71,7 +71,6 @@ pub struct Space<'a> {
 pub struct Edited {
     /// The attributes asked for.
     pub requested: Attributes,
-    pub latent: Vec<f32>,
     pub table: MerlTable,
 }
 
@@ -100,7 +99,7 @@ impl Space<'_> {
             }
         };
         let table = self.codec.decode(&latent)?;
-        Ok(Edited { requested, latent, table })
+        Ok(Edited { requested, table })
     }
 }
 
