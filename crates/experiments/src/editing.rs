@@ -36,8 +36,9 @@ impl EditMode {
     }
 }
 
-/// The default `--mode`: the residual edit, which measured better on every row of the
-/// `figures-editing` suite (README, "Editing").
+/// The default `--mode`: the residual edit. In the `figures-editing` suite (README, "Editing")
+/// the two are close on the edits themselves (each ahead on some rows), and the residual edit
+/// keeps an unedited material as it is (identity image RelAE 0.001 against 0.053).
 pub const DEFAULT_MODE: EditMode = EditMode::Residual;
 
 /// A DeepBRDF model as a [`Codec`] (eq. (2) to encode, eq. (3) to decode).

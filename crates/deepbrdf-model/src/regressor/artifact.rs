@@ -9,8 +9,7 @@ use std::fmt;
 use std::path::Path;
 
 use burn::prelude::*;
-use burn::store::ModuleRecord;
-use burn::tensor::{Bytes, TensorData};
+use burn::tensor::TensorData;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
@@ -235,8 +234,8 @@ impl Regressor {
         manifest.scaling.validate(manifest.target.k).map_err(|e| bad(e.to_string()))?;
         let device = device.clone().without_autodiff();
         let skeleton = crate::seeded::exclusive(|| RegressorNet::init(&shape, &device));
-        let record = ModuleRecord::from_bytes(Bytes::from_bytes_vec(weights.clone()))
-            .map_err(|e| bad(format!("bad weights: {e}")))?;
+        let record =
+            crate::record::float_record(weights.clone()).map_err(|e| bad(format!("bad weights: {e}")))?;
         let net = skeleton
             .try_load_record(record)
             .map_err(|e| bad(format!("the weights do not fit the network: {e}")))?;

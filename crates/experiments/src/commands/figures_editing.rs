@@ -95,7 +95,10 @@ struct Rep<'a> {
 
 fn mean(v: impl Iterator<Item = f64>) -> f64 {
     let v: Vec<f64> = v.filter(|x| x.is_finite()).collect();
-    v.iter().sum::<f64>() / v.len().max(1) as f64
+    match v.is_empty() {
+        true => f64::NAN,
+        false => v.iter().sum::<f64>() / v.len() as f64,
+    }
 }
 
 fn median(v: impl Iterator<Item = f64>) -> f64 {
