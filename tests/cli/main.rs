@@ -11,5 +11,6 @@ mod fetch_merl;
 mod kill;
 mod model;
 mod reliability;
+mod recovery;
 mod render;
 mod sweep_k;

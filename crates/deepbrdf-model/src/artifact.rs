@@ -87,12 +87,12 @@ impl Provenance {
     }
 }
 
-/// Checksum of one part file.
+/// Checksum of one part file (also of the networks saved beside a model: [`crate::recovery`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-struct Part {
-    file: String,
-    bytes: u64,
-    sha256: String,
+pub(crate) struct Part {
+    pub(crate) file: String,
+    pub(crate) bytes: u64,
+    pub(crate) sha256: String,
 }
 
 /// The content of `model.json`.
@@ -282,23 +282,7 @@ impl ModelArtifact {
         if self.weights.is_empty() {
             return Err(ModelError::Invalid("this artifact's weights were handed over".into()));
         }
-        if dir.exists() && !dir.join(MANIFEST_FILE).is_file() {
-            return Err(ModelError::Invalid(format!(
-                "{} exists and is not a DeepBRDF model; not replacing it",
-                dir.display()
-            )));
-        }
-        let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let tmp = dir.with_file_name(format!(".{name}.tmp{}", std::process::id()));
-        if tmp.exists() {
-            fs::remove_dir_all(&tmp).map_err(|e| ModelError::io(&tmp, e))?;
-        }
-        fs::create_dir_all(&tmp).map_err(|e| ModelError::io(&tmp, e))?;
-        let result = self.write_parts(&tmp).and_then(|()| replace_dir(&tmp, dir));
-        if result.is_err() {
-            let _ = fs::remove_dir_all(&tmp);
-        }
-        result
+        save_dir(dir, MANIFEST_FILE, "a DeepBRDF model", |tmp| self.write_parts(tmp))
     }
 
     fn write_parts(&self, dir: &Path) -> Result<()> {
@@ -439,8 +423,8 @@ fn manifest_id(config: &serde_json::Value, provenance: &Provenance, parts: &Part
     hex::encode(&digest[..16])
 }
 
-/// Loads burnpack `weights` into `network`.
-fn load_weights(network: Autoencoder, weights: Vec<u8>) -> Result<Autoencoder> {
+/// Loads burnpack `weights` into `network` (any network).
+pub(crate) fn load_weights<M: Module>(network: M, weights: Vec<u8>) -> Result<M> {
     let bad = |e: burn::store::RecordError| {
         ModelError::Invalid(format!("the weights do not fit the configuration: {e}"))
     };
@@ -466,7 +450,7 @@ pub(crate) fn canonical(value: serde_json::Value) -> serde_json::Value {
     }
 }
 
-fn part_of(bytes: &[u8], file: &str) -> Part {
+pub(crate) fn part_of(bytes: &[u8], file: &str) -> Part {
     Part {
         file: file.into(),
         bytes: bytes.len() as u64,
@@ -490,6 +474,33 @@ pub fn resolve_dir(path: &Path) -> Result<PathBuf> {
         path,
         format!("not a DeepBRDF model (no {MANIFEST_FILE} here or in {MODEL_DIR}/)"),
     ))
+}
+
+/// Writes an artifact directory `dir` with `write_parts` into a temporary sibling and renames
+/// it into place. An existing `dir` is replaced only if it holds `manifest` (it is `what`).
+pub(crate) fn save_dir(
+    dir: &Path,
+    manifest: &str,
+    what: &str,
+    write_parts: impl FnOnce(&Path) -> Result<()>,
+) -> Result<()> {
+    if dir.exists() && !dir.join(manifest).is_file() {
+        return Err(ModelError::Invalid(format!(
+            "{} exists and is not {what}; not replacing it",
+            dir.display()
+        )));
+    }
+    let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let tmp = dir.with_file_name(format!(".{name}.tmp{}", std::process::id()));
+    if tmp.exists() {
+        fs::remove_dir_all(&tmp).map_err(|e| ModelError::io(&tmp, e))?;
+    }
+    fs::create_dir_all(&tmp).map_err(|e| ModelError::io(&tmp, e))?;
+    let result = write_parts(&tmp).and_then(|()| replace_dir(&tmp, dir));
+    if result.is_err() {
+        let _ = fs::remove_dir_all(&tmp);
+    }
+    result
 }
 
 /// Moves the finished directory `tmp` to `dir`, replacing an older artifact there.

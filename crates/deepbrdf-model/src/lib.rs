@@ -8,6 +8,7 @@
 //! - [`artifact`]: the self-contained saved model; [`codec`]: encode / decode with it;
 //!   [`compact`]: the spectral basis in the compact form the codec decodes with.
 //! - [`fit`]: all of the above on a set of MERL tables.
+//! - [`recovery`]: single-image recovery (§5.2): the CNN from a photo to the latent, Fig. 15.
 pub mod artifact;
 mod atomic;
 pub mod autoencoder;
@@ -22,6 +23,7 @@ pub mod preset;
 pub mod principal;
 pub mod regressor;
 mod record;
+pub mod recovery;
 pub mod seeded;
 pub mod spectral;
 pub mod timing;

@@ -52,6 +52,17 @@ pub enum Command {
     Convert(commands::convert::Args),
     /// Evaluate the PCA and IPCA baselines (§4): summary table, CSV, plots.
     Baselines(commands::baselines::Args),
+    /// Render the synthetic training set of single-image recovery (§5.2): one material per
+    /// image on random shapes, views and skies; resumable.
+    RenderSet(commands::render_set::Args),
+    /// Train the recovery CNN (Fig. 15) from images to a model's latent (or to the 7
+    /// attributes); resumable.
+    TrainRecovery(commands::train_recovery::Args),
+    /// Recover a MERL BRDF from one photo of an object (§5.2).
+    Recover(commands::recover::Args),
+    /// Measure single-image recovery against its baselines on held-out and other materials;
+    /// the table, Fig. 16 and Fig. 17 under results/recovery.
+    FiguresRecovery(commands::figures_recovery::Args),
     /// Estimate the 7 editable attributes (§5.1: diffuse and specular albedo RGB, GGX
     /// roughness) of materials by a Lambertian + GGX fit; CSV and table.
     Attributes(commands::attributes::Args),

@@ -13,6 +13,7 @@ mod nested_baseline;
 mod progress;
 mod progress_log;
 mod readme_block;
+mod recovery_inputs;
 mod robustness;
 mod scene_args;
 mod slices_figure;

@@ -13,16 +13,20 @@ pub mod edit;
 pub mod encode;
 pub mod fetch_merl;
 pub mod figures_editing;
+pub mod figures_recovery;
 pub mod info;
 pub mod interpolate;
 pub mod pack_nbrdf;
 pub mod reconstruct;
+pub mod recover;
 pub mod render;
+pub mod render_set;
 pub mod sheet;
 pub mod sweep_k;
 pub mod tabulate;
 pub mod train;
 pub mod train_regressor;
+pub mod train_recovery;
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     let progress = Bars::new(cli.quiet);
@@ -49,5 +53,9 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Edit(args) => edit::run(args, &progress),
         Command::Interpolate(args) => interpolate::run(args, &progress),
         Command::FiguresEditing(args) => figures_editing::run(args, &progress),
+        Command::RenderSet(args) => render_set::run(args, &progress),
+        Command::TrainRecovery(args) => train_recovery::run(args, &progress),
+        Command::Recover(args) => recover::run(args, &progress),
+        Command::FiguresRecovery(args) => figures_recovery::run(args, &progress),
     }
 }

@@ -7,8 +7,10 @@ pub mod edit;
 pub mod io;
 pub mod lookup;
 pub mod model;
+pub mod recover;
 pub mod render;
 pub mod render_noise;
+pub mod render_set;
 pub mod tabulate;
 
 #[derive(Debug, clap::Args)]
@@ -40,6 +42,11 @@ pub enum What {
     /// Renderer efficiency at equal noise: seconds per image, relative noise between two seeds
     /// and 1 / (noise^2 x s), per material and light (issue 16).
     RenderNoise(render_noise::Args),
+    /// Images per second of the recovery render set (§5.2) at its CPU default.
+    RenderSet(render_set::Args),
+    /// Seconds of one single-image recovery: prepare, network, decode (target: network +
+    /// decode <= 0.5 s on 2 cores).
+    Recover(recover::Args),
 }
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
@@ -52,5 +59,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         What::RenderNoise(a) => render_noise::run(a, progress),
         What::Convert(a) => convert::run(a, progress),
         What::Edit(a) => edit::run(a, progress),
+        What::RenderSet(a) => render_set::run(a, progress),
+        What::Recover(a) => recover::run(a, progress),
     }
 }

@@ -1,0 +1,357 @@
+//! The saved recovery CNN, as `artifact.rs` saves DeepBRDF models: a directory with a manifest
+//! whose id covers the configuration, what the network predicts, its provenance and the
+//! checksum of its weights.
+//!
+//! ```text
+//! recovery/
+//!   recovery.json   id, network configuration, target (the DeepBRDF model id whose latent it
+//!                   predicts, or the 7 attributes), standardisation, provenance, weights checksum
+//!   weights.bpk     the network's parameters (burnpack)
+//! ```
+//!
+//! A network for one DeepBRDF model is refused for another ([`RecoveryArtifact::check_model`]):
+//! its outputs mean nothing in another model's latent space.
+
+use std::path::{Path, PathBuf};
+
+use burn::prelude::*;
+use burn::tensor::TensorData;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+use super::network::{RecoveryConfig, RecoveryNet};
+use super::step::RecoveryTrained;
+use crate::artifact::{canonical, load_weights, part_of, save_dir, Part};
+use crate::atomic::{read_limited, write_atomic};
+use crate::error::{ModelError, Result};
+
+/// File name of the manifest.
+pub const RECOVERY_MANIFEST: &str = "recovery.json";
+/// File name of the weights.
+pub const RECOVERY_WEIGHTS: &str = "weights.bpk";
+/// Name of the recovery network's directory beside a model (`models/default/recovery`).
+pub const RECOVERY_DIR: &str = "recovery";
+const FORMAT: &str = "deepbrdf-recovery";
+const VERSION: u32 = 1;
+
+/// What the network's outputs are.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum RecoveryTarget {
+    /// The k latent values of the DeepBRDF model with this id (decoded by that model).
+    Latent { model_id: String, k: usize },
+    /// The 7 Lambertian + GGX attributes of §5.1 (diffuse RGB, specular RGB, roughness): the
+    /// analytic baseline of the same CNN.
+    Attributes,
+}
+
+impl RecoveryTarget {
+    /// Number of outputs.
+    pub fn outputs(&self) -> usize {
+        match self {
+            Self::Latent { k, .. } => *k,
+            Self::Attributes => 7,
+        }
+    }
+}
+
+/// How the network was trained.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RecoveryProvenance {
+    /// The render set's folder as given, and its manifest's digest.
+    pub set: String,
+    pub set_digest: String,
+    /// Training images and their materials.
+    pub images: usize,
+    pub materials: Vec<String>,
+    /// Digest of the prepared examples.
+    pub data_fingerprint: String,
+    /// The loop's settings and the preset's name.
+    pub train_config: serde_json::Value,
+    pub epochs: usize,
+    pub final_loss: f64,
+    pub train_seconds: f64,
+    pub device: String,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Manifest {
+    format: String,
+    version: u32,
+    id: String,
+    config: serde_json::Value,
+    target: RecoveryTarget,
+    mean: Vec<f32>,
+    scale: Vec<f32>,
+    provenance: RecoveryProvenance,
+    weights: Part,
+}
+
+/// A trained recovery network in memory.
+#[derive(Debug, Clone)]
+pub struct RecoveryArtifact {
+    config: RecoveryConfig,
+    target: RecoveryTarget,
+    mean: Vec<f32>,
+    scale: Vec<f32>,
+    provenance: RecoveryProvenance,
+    weights: Vec<u8>,
+    part: Part,
+    id: String,
+}
+
+impl RecoveryArtifact {
+    /// Bundles a trained network with what it predicts.
+    pub fn new(
+        config: RecoveryConfig,
+        target: RecoveryTarget,
+        trained: &RecoveryTrained,
+        provenance: RecoveryProvenance,
+    ) -> Result<Self> {
+        if target.outputs() != config.outputs {
+            return Err(ModelError::Invalid(format!(
+                "the network has {} outputs, its target {target:?} {}",
+                config.outputs,
+                target.outputs()
+            )));
+        }
+        let weights = trained
+            .model
+            .clone()
+            .into_record()
+            .into_bytes()
+            .map_err(|e| ModelError::Invalid(format!("cannot serialise the weights: {e}")))?
+            .to_vec();
+        let weights = crate::record::rewrite(weights, false, |name| name)
+            .map_err(|e| ModelError::Invalid(format!("cannot serialise the weights: {e}")))?;
+        let part = part_of(&weights, RECOVERY_WEIGHTS);
+        let mut artifact = Self {
+            config,
+            target,
+            mean: trained.mean.clone(),
+            scale: trained.scale.clone(),
+            provenance,
+            weights,
+            part,
+            id: String::new(),
+        };
+        artifact.id = artifact.manifest_id()?;
+        Ok(artifact)
+    }
+
+    pub fn id(&self) -> &str {
+        &self.id
+    }
+
+    pub fn config(&self) -> &RecoveryConfig {
+        &self.config
+    }
+
+    pub fn target(&self) -> &RecoveryTarget {
+        &self.target
+    }
+
+    pub fn provenance(&self) -> &RecoveryProvenance {
+        &self.provenance
+    }
+
+    /// Errors unless this network predicts the latent of the DeepBRDF model `model_id`.
+    pub fn check_model(&self, model_id: &str) -> Result<()> {
+        match &self.target {
+            RecoveryTarget::Latent { model_id: own, .. } if own == model_id => Ok(()),
+            RecoveryTarget::Latent { model_id: own, .. } => Err(ModelError::Invalid(format!(
+                "this recovery network predicts the latent of DeepBRDF model {own}, not of model \
+                 {model_id}: train one for this model with `experiments train-recovery`"
+            ))),
+            RecoveryTarget::Attributes => Err(ModelError::Invalid(
+                "this recovery network predicts the 7 analytic attributes, not a DeepBRDF latent"
+                    .into(),
+            )),
+        }
+    }
+
+    fn manifest_id(&self) -> Result<String> {
+        let config = serde_json::to_value(&self.config)
+            .map_err(|e| ModelError::Invalid(format!("cannot serialise the configuration: {e}")))?;
+        let content = serde_json::json!({
+            "config": config,
+            "target": self.target,
+            "mean": self.mean,
+            "scale": self.scale,
+            "provenance": self.provenance,
+            "weights": self.part,
+        });
+        let digest = Sha256::digest(canonical(content).to_string().as_bytes());
+        Ok(hex::encode(&digest[..16]))
+    }
+
+    /// The network on `device` (inference) with its standardisation.
+    pub fn predictor(&self, device: &Device) -> Result<Predictor> {
+        let device = device.clone().without_autodiff();
+        let net = crate::seeded::exclusive(|| self.config.init(&device))?;
+        let net = load_weights(net, self.weights.clone())?.valid();
+        Ok(Predictor {
+            net,
+            side: self.config.input_side,
+            mean: self.mean.clone(),
+            scale: self.scale.clone(),
+            device,
+        })
+    }
+
+    /// Writes the directory `dir` (beside it, then renamed into place); an existing `dir` is
+    /// replaced only if it is itself a recovery network.
+    pub fn save(&self, dir: &Path) -> Result<()> {
+        save_dir(dir, RECOVERY_MANIFEST, "a recovery network", |tmp| self.write_parts(tmp))
+    }
+
+    fn write_parts(&self, dir: &Path) -> Result<()> {
+        write_atomic(&dir.join(RECOVERY_WEIGHTS), &[&self.weights])?;
+        let manifest = Manifest {
+            format: FORMAT.into(),
+            version: VERSION,
+            id: self.id.clone(),
+            config: serde_json::to_value(&self.config)
+                .map_err(|e| ModelError::Invalid(format!("cannot serialise: {e}")))?,
+            target: self.target.clone(),
+            mean: self.mean.clone(),
+            scale: self.scale.clone(),
+            provenance: self.provenance.clone(),
+            weights: self.part.clone(),
+        };
+        let json = serde_json::to_string_pretty(&manifest)
+            .map_err(|e| ModelError::Invalid(format!("cannot serialise the manifest: {e}")))?;
+        write_atomic(&dir.join(RECOVERY_MANIFEST), &[json.as_bytes(), b"\n"])
+    }
+
+    /// Loads a recovery network directory (or the `recovery/` inside a model directory),
+    /// checking its parts belong together.
+    pub fn load(path: &Path) -> Result<Self> {
+        let dir = resolve(path)?;
+        let manifest_path = dir.join(RECOVERY_MANIFEST);
+        let text = read_limited(&manifest_path, 16 << 20)?;
+        let manifest: Manifest = serde_json::from_slice(&text).map_err(|e| {
+            ModelError::format(&manifest_path, format!("not a recovery network manifest: {e}"))
+        })?;
+        if manifest.format != FORMAT || manifest.version != VERSION {
+            return Err(ModelError::format(
+                &manifest_path,
+                format!(
+                    "format {} version {}, expected {FORMAT} version {VERSION}",
+                    manifest.format, manifest.version
+                ),
+            ));
+        }
+        let config: RecoveryConfig =
+            serde_json::from_value(manifest.config.clone()).map_err(|e| {
+                ModelError::format(&manifest_path, format!("bad network configuration: {e}"))
+            })?;
+        config.validate()?;
+        let k = config.outputs;
+        if manifest.target.outputs() != k || manifest.mean.len() != k || manifest.scale.len() != k {
+            return Err(ModelError::format(
+                &manifest_path,
+                format!("the network has {k} outputs; its target and standardisation disagree"),
+            ));
+        }
+        let weights_path = dir.join(RECOVERY_WEIGHTS);
+        let weights = read_limited(&weights_path, 1 << 30)?;
+        if part_of(&weights, RECOVERY_WEIGHTS) != manifest.weights {
+            return Err(ModelError::mismatch(
+                &weights_path,
+                format!(
+                    "these weights do not belong to recovery network {} (checksum differs)",
+                    manifest.id
+                ),
+            ));
+        }
+        let artifact = Self {
+            config,
+            target: manifest.target,
+            mean: manifest.mean,
+            scale: manifest.scale,
+            provenance: manifest.provenance,
+            weights,
+            part: manifest.weights,
+            id: manifest.id.clone(),
+        };
+        if artifact.manifest_id()? != manifest.id {
+            return Err(ModelError::mismatch(
+                &manifest_path,
+                "the manifest was edited or damaged (its id does not match its content)",
+            ));
+        }
+        Ok(artifact)
+    }
+}
+
+/// `path` if it holds a recovery manifest, else `path/recovery` if that does.
+fn resolve(path: &Path) -> Result<PathBuf> {
+    if path.join(RECOVERY_MANIFEST).is_file() {
+        return Ok(path.to_path_buf());
+    }
+    let inner = path.join(RECOVERY_DIR);
+    if inner.join(RECOVERY_MANIFEST).is_file() {
+        return Ok(inner);
+    }
+    if !path.exists() {
+        return Err(ModelError::io(path, std::io::Error::from(std::io::ErrorKind::NotFound)));
+    }
+    Err(ModelError::format(
+        path,
+        format!("not a recovery network (no {RECOVERY_MANIFEST} here or in {RECOVERY_DIR}/)"),
+    ))
+}
+
+/// A loaded recovery network: prepared images in, targets out.
+#[derive(Debug)]
+pub struct Predictor {
+    net: RecoveryNet,
+    side: usize,
+    mean: Vec<f32>,
+    scale: Vec<f32>,
+    device: Device,
+}
+
+impl Predictor {
+    /// Side of the images it takes.
+    pub fn side(&self) -> usize {
+        self.side
+    }
+
+    /// The targets of `images` (`n` prepared images `[3, side, side]`, concatenated), `n`
+    /// rows of outputs.
+    pub fn predict(&self, images: &[f32]) -> Result<Vec<Vec<f32>>> {
+        let per = 3 * self.side * self.side;
+        let n = images.len() / per;
+        if n == 0 || n * per != images.len() {
+            return Err(ModelError::Invalid(format!(
+                "{} values are not whole {}x{} colour images",
+                images.len(),
+                self.side,
+                self.side
+            )));
+        }
+        let k = self.mean.len();
+        let mut rows = Vec::with_capacity(n);
+        for chunk in images.chunks(64 * per) {
+            let b = chunk.len() / per;
+            let x = Tensor::<4>::from_data(
+                TensorData::new(chunk.to_vec(), [b, 3, self.side, self.side]),
+                &self.device,
+            );
+            let y: Vec<f32> = self
+                .net
+                .forward(x)
+                .into_data()
+                .try_into_vec()
+                .map_err(|e| ModelError::Invalid(format!("cannot read the outputs: {e:?}")))?;
+            for row in y.chunks_exact(k) {
+                rows.push(
+                    row.iter().enumerate().map(|(j, v)| v * self.scale[j] + self.mean[j]).collect(),
+                );
+            }
+        }
+        Ok(rows)
+    }
+}

@@ -1,0 +1,461 @@
+//! `experiments figures-recovery`: single-image recovery (§5.2) measured against its baselines,
+//! with Fig. 16 (input / ground truth / recovered) and Fig. 17 (planes: DeepBRDF against the
+//! analytic fit), written under `results/recovery/`.
+//!
+//! Every image of a test set (rendered with `render-set --only-fold`, so its materials are held
+//! out of the training set, the CNN and, when the model was trained without them, the
+//! autoencoder; or a set of another collection, for generalization) is recovered by four
+//! methods: DeepBRDF (the CNN's latent, decoded), the analytic baseline (the same CNN with 7
+//! outputs, Lambertian + GGX), the nearest neighbour (the training material whose render in the
+//! input's own scene is closest to the input) and the training mean (the per-value mean of the
+//! training materials). Each recovered table and the true one are rendered in a *novel* scene
+//! (another shape, view and sky than the input's: the input view alone rewards copying its
+//! highlights) and compared by image RelAE; the mapped-space (eq. 1) MSE of the tables is
+//! reported beside it.
+use crate::data_args::CacheArg;
+use crate::model_arg::ModelArg;
+use crate::recovery_inputs::{attributes_of, load_tables, set_images};
+use anyhow::{bail, Context};
+use deepbrdf_data::merl::{CELLS, INVALID_VALUE, VALUES};
+use deepbrdf_data::{MerlTable, Progress, Silent};
+use deepbrdf_eval::harness::{Measure, Yardstick};
+use deepbrdf_eval::metrics::{ImageRelae, ImageRelaeConfig};
+use deepbrdf_model::recovery::{RecoveryArtifact, RecoveryTarget};
+use deepbrdf_model::DeepBrdf;
+use deepbrdf_render::sheet::{contact_sheet, SheetConfig, Tile};
+use deepbrdf_render::{
+    camera_png, render, MerlBrdf, Photo, RenderSet, RenderSettings, SceneSampler, Shape,
+    Srgb8Image, Tonemap,
+};
+use rayon::prelude::*;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// The methods, in table order.
+const METHODS: [&str; 4] = ["deepbrdf", "analytic", "nearest", "mean"];
+/// Seed offset of the novel scenes (another stream than the inputs').
+const NOVEL_SEED: u64 = 0x6e6f_7665_6c;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    pub model: ModelArg,
+    #[command(flatten)]
+    pub network: super::recover::NetworkArg,
+    /// The analytic baseline: a recovery network trained with `--target attributes`.
+    #[arg(long, value_name = "DIR")]
+    pub analytic: PathBuf,
+    /// The render set the networks were trained on (its materials are the nearest-neighbour
+    /// candidates and make the training mean).
+    #[arg(long, value_name = "DIR")]
+    pub train_set: PathBuf,
+    /// Held-out test set (`render-set --only-fold`), the table's first block.
+    #[arg(long, value_name = "DIR")]
+    pub test_set: PathBuf,
+    /// Further test sets of materials never trained on (generalization), NAME=DIR.
+    #[arg(long, value_name = "NAME=DIR")]
+    pub generalize: Vec<String>,
+    /// Output folder.
+    #[arg(long, value_name = "DIR", default_value = "results/recovery")]
+    pub out: PathBuf,
+    /// Side and samples per pixel of the novel-scene renders.
+    #[arg(long, default_value_t = 64)]
+    pub size: u32,
+    #[arg(long, default_value_t = 32)]
+    pub spp: u32,
+    /// Samples per pixel of the nearest-neighbour search's renders (every training material in
+    /// every input's scene: the costly part).
+    #[arg(long, default_value_t = 4)]
+    pub nn_spp: u32,
+    #[command(flatten)]
+    pub cache: CacheArg,
+}
+
+/// One image's results.
+struct Row {
+    set: String,
+    index: usize,
+    material: String,
+    shape: &'static str,
+    relae: [f64; 4],
+    mse: [f64; 4],
+    nearest: String,
+}
+
+/// Figure material kept for a few images.
+struct Shown {
+    input: Srgb8Image,
+    truth: Srgb8Image,
+    recovered: [Srgb8Image; 2],
+    material: String,
+}
+
+pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
+    let device = crate::device_arg::device()?;
+    let model_dir = args.model.dir()?;
+    let model = DeepBrdf::load(&model_dir, &device)?;
+    let network = args.network.load(&model_dir, &model)?;
+    let analytic = RecoveryArtifact::load(&args.analytic)?;
+    if analytic.target() != &RecoveryTarget::Attributes {
+        bail!(
+            "{}: not an attributes network (train it with --target attributes)",
+            args.analytic.display()
+        );
+    }
+    let cache = args.cache.cache();
+    let train = RenderSet::load(&args.train_set)?;
+    let train_tables = load_tables(&train.header.materials, &cache, progress)?;
+    let mean = mean_table(train_tables.values().collect::<Vec<_>>().as_slice())?;
+    let yardstick = Yardstick::from_reference(model.reference().clone());
+
+    let mut sets = vec![("held-out".to_string(), args.test_set.clone())];
+    for g in &args.generalize {
+        let (name, dir) =
+            g.split_once('=').with_context(|| format!("--generalize '{g}': expected NAME=DIR"))?;
+        sets.push((name.to_string(), PathBuf::from(dir)));
+    }
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let mut rows = Vec::new();
+    let mut shown: Vec<Shown> = Vec::new();
+    let mut planes: Vec<Shown> = Vec::new();
+    for (name, dir) in &sets {
+        let set = RenderSet::load(dir)?;
+        let overlap: Vec<&String> =
+            set.header.materials.iter().filter(|m| train.header.materials.contains(m)).collect();
+        if !overlap.is_empty() {
+            bail!(
+                "{}: {} of its materials (e.g. {}) are in the training set; not held out",
+                dir.display(),
+                overlap.len(),
+                overlap[0]
+            );
+        }
+        let truth = load_tables(&set.header.materials, &cache, progress)?;
+        let indices: Vec<usize> = (0..set.images.len()).collect();
+        let side = network.config().input_side;
+        let inputs = set_images(&set, dir, &indices, side, progress)?;
+        let latents = network.predictor(&device)?.predict(&inputs)?;
+        let side7 = analytic.config().input_side;
+        let inputs7 = if side7 == side {
+            inputs.clone()
+        } else {
+            set_images(&set, dir, &indices, side7, progress)?
+        };
+        let attributes = analytic.predictor(&device)?.predict(&inputs7)?;
+        let nearest = nearest_materials(&set, &inputs, side, &train_tables, args.nn_spp, progress)?;
+        progress.start(set.images.len() as u64, &format!("measuring {name}"));
+        for (i, image) in set.images.iter().enumerate() {
+            let t = &truth[&image.material];
+            let decoded = model.decode(&latents[i])?;
+            let fitted = attributes_of(&attributes[i])?.table();
+            let near = &train_tables[&nearest[i]];
+            let recon: [&MerlTable; 4] = [&decoded, &fitted, near, &mean];
+            let cfg = ImageRelaeConfig {
+                scene: novel_scene(&set, i),
+                render: RenderSettings {
+                    size: args.size,
+                    spp: args.spp,
+                    seed: 0x5eed,
+                    jitter: true,
+                },
+            };
+            let relae_of = ImageRelae::new(t, &cfg)?;
+            let original = yardstick.original(t);
+            let mut relae = [0.0; 4];
+            let mut mse = [0.0; 4];
+            for (m, r) in recon.iter().enumerate() {
+                relae[m] = relae_of.measure(r)?;
+                mse[m] = yardstick.measure(&original, r, &[Measure::MappedMse])?[0];
+            }
+            let is_plane = matches!(image.scene.scene.shape, Shape::Plane { .. });
+            let input_png = || Photo::read(&set.paths(dir, i).0).map(|p| p.to_srgb8());
+            if name == "held-out"
+                && !is_plane
+                && shown.len() < 6
+                && !shown.iter().any(|s| s.material == image.material)
+            {
+                let tm = Tonemap::default();
+                shown.push(Shown {
+                    input: input_png()?,
+                    truth: relae_of.reference().to_srgb8(&tm, [0, 0, 0]),
+                    recovered: [
+                        relae_of.render(&decoded)?.to_srgb8(&tm, [0, 0, 0]),
+                        relae_of.render(&fitted)?.to_srgb8(&tm, [0, 0, 0]),
+                    ],
+                    material: image.material.clone(),
+                });
+            }
+            if name == "held-out" && is_plane && planes.len() < 4 {
+                // Fig. 17: the plane of the input itself, re-rendered with each table.
+                let own = ImageRelaeConfig {
+                    scene: image.scene.scene,
+                    render: RenderSettings {
+                        size: set.header.size,
+                        spp: args.spp,
+                        seed: image.scene.render_seed,
+                        jitter: true,
+                    },
+                };
+                let on_plane = ImageRelae::new(t, &own)?;
+                let develop =
+                    |img: &deepbrdf_render::Image| camera_png(img, image.scene.exposure, 0.0, 0);
+                planes.push(Shown {
+                    input: input_png()?,
+                    truth: develop(on_plane.reference()),
+                    recovered: [
+                        develop(&on_plane.render(&decoded)?),
+                        develop(&on_plane.render(&fitted)?),
+                    ],
+                    material: image.material.clone(),
+                });
+            }
+            rows.push(Row {
+                set: name.clone(),
+                index: i,
+                material: image.material.clone(),
+                shape: image.scene.scene.shape.name(),
+                relae,
+                mse,
+                nearest: nearest[i].clone(),
+            });
+            progress.advance(1);
+        }
+        progress.finish();
+    }
+    write_outputs(&args, &rows, &shown, &planes, &model, &network, &analytic)
+}
+
+/// The novel scene of image `i`: drawn from another stream than the inputs', with another
+/// shape than the input's.
+fn novel_scene(set: &RenderSet, i: usize) -> deepbrdf_render::SceneConfig {
+    let sampler = SceneSampler::default();
+    let mut scene = sampler.sample(set.header.seed ^ NOVEL_SEED, i as u64).scene;
+    let input = set.images[i].scene.scene.shape;
+    if scene.shape.name() == input.name() {
+        let k = sampler.shapes.iter().position(|s| s.name() == input.name()).unwrap_or(0);
+        scene.shape = sampler.shapes[(k + 1) % sampler.shapes.len()];
+        if matches!(scene.shape, Shape::Plane { .. }) {
+            scene.view_theta_deg = scene.view_theta_deg.min(sampler.plane_view_theta_deg[1]);
+        }
+    }
+    scene
+}
+
+/// The per-value mean of `tables` over the cells valid in all of them (others invalid).
+fn mean_table(tables: &[&MerlTable]) -> anyhow::Result<MerlTable> {
+    anyhow::ensure!(!tables.is_empty(), "no training material for the mean");
+    let mut values = vec![0f32; VALUES];
+    values.par_chunks_mut(CELLS).enumerate().for_each(|(c, out)| {
+        for (cell, v) in out.iter_mut().enumerate() {
+            let i = c * CELLS + cell;
+            if tables.iter().all(|t| t.is_valid(cell)) {
+                *v = (tables.iter().map(|t| f64::from(t.values()[i])).sum::<f64>()
+                    / tables.len() as f64) as f32;
+            } else {
+                *v = INVALID_VALUE;
+            }
+        }
+    });
+    Ok(MerlTable::from_values(values)?)
+}
+
+/// For each image of `set`, the training material whose render in the image's own scene
+/// (same seed and exposure, `spp` samples, no noise), prepared like the input, is closest to the prepared input
+/// (squared distance).
+fn nearest_materials(
+    set: &RenderSet,
+    inputs: &[f32],
+    side: usize,
+    train: &BTreeMap<String, MerlTable>,
+    spp: u32,
+    progress: &dyn Progress,
+) -> anyhow::Result<Vec<String>> {
+    let per = 3 * side * side;
+    let n = set.images.len();
+    let mut best = vec![(f64::INFINITY, String::new()); n];
+    let scenes: Vec<deepbrdf_render::Scene> =
+        set.images.iter().map(|im| im.scene.scene.build()).collect::<Result<Vec<_>, _>>()?;
+    progress.start(train.len() as u64, "nearest neighbours");
+    for (name, table) in train {
+        let brdf = MerlBrdf::new(table);
+        let distances: Vec<f64> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let im = &set.images[i];
+                let settings = RenderSettings {
+                    size: set.header.size,
+                    spp,
+                    seed: im.scene.render_seed,
+                    jitter: true,
+                };
+                let Ok(linear) = render(&scenes[i], &brdf, &settings, &Silent) else {
+                    return f64::INFINITY;
+                };
+                let png = camera_png(&linear, im.scene.exposure, 0.0, 0);
+                match Photo::from_srgb8(&png).network_input(side as u32, name) {
+                    Ok(x) => x
+                        .iter()
+                        .zip(&inputs[i * per..(i + 1) * per])
+                        .map(|(a, b)| f64::from(a - b).powi(2))
+                        .sum(),
+                    Err(_) => f64::INFINITY,
+                }
+            })
+            .collect();
+        for (b, d) in best.iter_mut().zip(distances) {
+            if d < b.0 {
+                *b = (d, name.clone());
+            }
+        }
+        progress.advance(1);
+    }
+    progress.finish();
+    if let Some(i) = best.iter().position(|b| b.1.is_empty()) {
+        bail!("image {i}: no training material renders to a usable image in its scene");
+    }
+    Ok(best.into_iter().map(|b| b.1).collect())
+}
+
+fn mean(v: impl Iterator<Item = f64>) -> f64 {
+    let v: Vec<f64> = v.collect();
+    v.iter().sum::<f64>() / v.len().max(1) as f64
+}
+
+fn median(v: impl Iterator<Item = f64>) -> f64 {
+    let mut v: Vec<f64> = v.collect();
+    v.sort_by(f64::total_cmp);
+    if v.is_empty() {
+        f64::NAN
+    } else {
+        v[v.len() / 2]
+    }
+}
+
+fn write_outputs(
+    args: &Args,
+    rows: &[Row],
+    shown: &[Shown],
+    planes: &[Shown],
+    model: &DeepBrdf,
+    network: &RecoveryArtifact,
+    analytic: &RecoveryArtifact,
+) -> anyhow::Result<()> {
+    let mut csv = String::from("set,index,material,shape,nearest");
+    for m in METHODS {
+        write!(csv, ",relae_{m}")?;
+    }
+    for m in METHODS {
+        write!(csv, ",mapped_mse_{m}")?;
+    }
+    csv.push('\n');
+    for r in rows {
+        write!(csv, "{},{},{},{},{}", r.set, r.index, r.material, r.shape, r.nearest)?;
+        for v in r.relae.iter().chain(&r.mse) {
+            write!(csv, ",{v:.6}")?;
+        }
+        csv.push('\n');
+    }
+    deepbrdf_data::files::write_atomic(&args.out.join("per_image.csv"), csv.as_bytes())?;
+
+    let mut md = String::new();
+    writeln!(md, "Single-image recovery (§5.2), written by `experiments figures-recovery` (see the README's Recovery section for the full command).")?;
+    writeln!(md)?;
+    writeln!(
+        md,
+        "DeepBRDF model {} (k = {}); recovery CNN {} ({} images, {} epochs); analytic CNN {}.",
+        model.id(),
+        model.k(),
+        network.id(),
+        network.provenance().images,
+        network.provenance().epochs,
+        analytic.id()
+    )?;
+    writeln!(md, "Novel-scene renders: {0}x{0} px, {1} spp. RelAE: image space, novel shape, view and sky; MSE: mapped space (eq. 1), the model's reference.", args.size, args.spp)?;
+    writeln!(md)?;
+    writeln!(md, "| test set | images | materials | method | RelAE mean | RelAE median | mapped MSE mean | best RelAE on |")?;
+    writeln!(md, "| --- | ---: | ---: | --- | ---: | ---: | ---: | ---: |")?;
+    let mut sets: Vec<&str> = rows.iter().map(|r| r.set.as_str()).collect();
+    sets.dedup();
+    for set in &sets {
+        let rs: Vec<&Row> = rows.iter().filter(|r| r.set == *set).collect();
+        let mut materials: Vec<&str> = rs.iter().map(|r| r.material.as_str()).collect();
+        materials.sort();
+        materials.dedup();
+        for (m, method) in METHODS.iter().enumerate() {
+            let wins = rs.iter().filter(|r| (0..4).all(|o| r.relae[m] <= r.relae[o])).count();
+            writeln!(
+                md,
+                "| {set} | {} | {} | {method} | {:.4} | {:.4} | {:.4} | {wins} |",
+                rs.len(),
+                materials.len(),
+                mean(rs.iter().map(|r| r.relae[m])),
+                median(rs.iter().map(|r| r.relae[m])),
+                mean(rs.iter().map(|r| r.mse[m])),
+            )?;
+        }
+    }
+    deepbrdf_data::files::write_atomic(&args.out.join("summary.md"), md.as_bytes())?;
+    print!("{md}");
+
+    let short = |m: &str| m.rsplit('/').next().unwrap_or(m).to_string();
+    let up = |img: &Srgb8Image| upscale(img, (128 / img.width.max(1)).max(1));
+    if !shown.is_empty() {
+        let mut tiles = Vec::new();
+        for (row, caption) in [(0, "input"), (1, "ground truth"), (2, "DeepBRDF")] {
+            for s in shown {
+                let image = match row {
+                    0 => &s.input,
+                    1 => &s.truth,
+                    _ => &s.recovered[0],
+                };
+                let caption = if row == 0 { short(&s.material) } else { caption.to_string() };
+                tiles.push(Tile { image: up(image), caption });
+            }
+        }
+        let sheet = contact_sheet(
+            &tiles,
+            &SheetConfig { columns: shown.len() as u32, ..Default::default() },
+        )?;
+        sheet.write_png(&args.out.join("fig16.png"))?;
+    }
+    if !planes.is_empty() {
+        let mut tiles = Vec::new();
+        for (row, caption) in
+            [(0, "input plane"), (1, "ground truth"), (2, "DeepBRDF"), (3, "analytic (GGX)")]
+        {
+            for s in planes {
+                let image = match row {
+                    0 => &s.input,
+                    1 => &s.truth,
+                    2 => &s.recovered[0],
+                    _ => &s.recovered[1],
+                };
+                let caption = if row == 0 { short(&s.material) } else { caption.to_string() };
+                tiles.push(Tile { image: up(image), caption });
+            }
+        }
+        let sheet = contact_sheet(
+            &tiles,
+            &SheetConfig { columns: planes.len() as u32, ..Default::default() },
+        )?;
+        sheet.write_png(&args.out.join("fig17.png"))?;
+    }
+    eprintln!("wrote {}/summary.md, per_image.csv, fig16.png, fig17.png", args.out.display());
+    Ok(())
+}
+
+/// Nearest-neighbour enlargement by an integer factor.
+fn upscale(img: &Srgb8Image, f: u32) -> Srgb8Image {
+    let (w, h) = (img.width * f, img.height * f);
+    let mut out = Srgb8Image::filled(w, h, [0, 0, 0]);
+    for y in 0..h {
+        for x in 0..w {
+            let s = 3 * ((y / f) * img.width + x / f) as usize;
+            let t = 3 * (y * w + x) as usize;
+            out.data[t..t + 3].copy_from_slice(&img.data[s..s + 3]);
+        }
+    }
+    out
+}

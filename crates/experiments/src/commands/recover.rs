@@ -1,0 +1,99 @@
+//! `experiments recover [--model DIR] IMAGE -o out.binary [--render compare.png]`: single-image
+//! BRDF recovery (§5.2, Fig. 15): the recovery CNN maps the photo to the model's latent vector
+//! and the model's decoder (eq. 3) turns it into a full MERL table.
+use crate::model_arg::ModelArg;
+use anyhow::Context;
+use deepbrdf_data::merl::write_merl;
+use deepbrdf_data::Progress;
+use deepbrdf_model::recovery::artifact::RECOVERY_DIR;
+use deepbrdf_model::recovery::RecoveryArtifact;
+use deepbrdf_model::DeepBrdf;
+use deepbrdf_render::photo::input_preview;
+use deepbrdf_render::{render, MerlBrdf, Photo, RenderSettings, SceneConfig, Srgb8Image, Tonemap};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Recover a MERL BRDF from one photo of an object.
+///
+/// Assumptions: one object of one homogeneous, isotropic material, roughly centred and wholly
+/// in view, lit by a sun-and-sky-like outdoor light, in front of a plain dark background (or
+/// cut out by an alpha channel); PNG, JPEG or EXR of any size (the object is cropped and
+/// resized to the network's input). Blank, saturated or object-less photos are refused.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    pub model: ModelArg,
+    #[command(flatten)]
+    pub network: NetworkArg,
+    /// The photo: PNG, JPEG or EXR.
+    pub image: PathBuf,
+    /// The recovered MERL .binary file to write.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+    /// Also write the input as the network sees it beside a render of the recovered material
+    /// (a sphere under the default sun and sky).
+    #[arg(long, value_name = "PNG")]
+    pub render: Option<PathBuf>,
+}
+
+/// `--network DIR`: the recovery network of a model.
+#[derive(Debug, Clone, clap::Args)]
+pub struct NetworkArg {
+    /// The recovery network [default: MODEL/recovery, where `train-recovery --out MODEL` and
+    /// the shipped model place it].
+    #[arg(long, value_name = "DIR")]
+    pub network: Option<PathBuf>,
+}
+
+impl NetworkArg {
+    /// The network of the model in `model_dir`, loaded and checked to predict `model`'s latent.
+    pub fn load(&self, model_dir: &Path, model: &DeepBrdf) -> anyhow::Result<RecoveryArtifact> {
+        let dir = match &self.network {
+            Some(n) => n.clone(),
+            None => model_dir.join(RECOVERY_DIR),
+        };
+        let network = RecoveryArtifact::load(&dir)
+            .with_context(|| format!("loading the recovery network {}", dir.display()))?;
+        network.check_model(model.id())?;
+        Ok(network)
+    }
+}
+
+pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
+    let device = crate::device_arg::device()?;
+    let model_dir = args.model.dir()?;
+    let model = DeepBrdf::load(&model_dir, &device)?;
+    let network = args.network.load(&model_dir, &model)?;
+    let photo = Photo::read(&args.image)?;
+    let side = network.config().input_side;
+    let what = args.image.display().to_string();
+    let input = photo.network_input(side as u32, &what)?;
+    let start = Instant::now();
+    let latent = network.predictor(&device)?.predict(&input)?.remove(0);
+    let table = model.decode(&latent)?;
+    let seconds = start.elapsed().as_secs_f64();
+    write_merl(&table, &args.output)?;
+    let text: Vec<String> = latent.iter().map(|v| format!("{v:.4}")).collect();
+    println!(
+        "{}: latent [{}] (network + decode {seconds:.2} s) -> {}",
+        args.image.display(),
+        text.join(" "),
+        args.output.display()
+    );
+    if let Some(path) = &args.render {
+        let tile = 128;
+        let seen = input_preview(&photo.network_input(tile, &what)?, tile);
+        let scene = SceneConfig::default().build()?;
+        let settings = RenderSettings { size: tile, spp: 32, seed: 0, jitter: true };
+        let image = render(&scene, &MerlBrdf::new(&table), &settings, progress)?;
+        let mut sheet = Srgb8Image::filled(2 * tile, tile, [0, 0, 0]);
+        sheet.blit(&seen, 0, 0);
+        sheet.blit(&image.to_srgb8(&Tonemap::default(), [0, 0, 0]), tile, 0);
+        sheet.write_png(path)?;
+        eprintln!(
+            "wrote {} (input as the network sees it | recovered, on a sphere)",
+            path.display()
+        );
+    }
+    Ok(())
+}

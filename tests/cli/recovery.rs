@@ -1,0 +1,190 @@
+//! Single-image recovery end to end on tiny data: `render-set` (a few 16-px images of three
+//! synthetic materials; resumed; a held-out fold), `train-recovery` (the cpu CNN for two
+//! epochs on a tiny spectral model), `recover` (a set image and unusable photos) and the
+//! refusal of a network trained for another model.
+use crate::util;
+use deepbrdf_data::merl::read_merl;
+use deepbrdf_model::burn::config::Config as _;
+use deepbrdf_model::{AutoencoderConfig, TrainConfig};
+use std::path::Path;
+
+fn s(p: &Path) -> String {
+    p.to_str().unwrap().to_string()
+}
+
+#[test]
+fn render_set_train_recovery_and_recover_chain() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = util::write_data(dir.path(), 3);
+    let ok = |args: &[&str]| {
+        let out = util::run_in(dir.path(), args);
+        assert!(out.status.success(), "{args:?}: {}", util::stderr(&out));
+        out
+    };
+    // A tiny spectral model (k = 2) on the three materials.
+    let mut config = TrainConfig::cpu(2).with_epochs(2).with_batch_size(2);
+    config.model = AutoencoderConfig::spectral(2, 3, Some(8));
+    let config_path = dir.path().join("tiny.json");
+    config.save(&config_path).unwrap();
+    let model = dir.path().join("model");
+    ok(&["train", "--config", &s(&config_path), "--data", &s(&data), "--out", &s(&model)]);
+
+    let set = dir.path().join("set");
+    let render = |n: &str| {
+        ok(&[
+            "render-set",
+            "--out",
+            &s(&set),
+            "--data",
+            &s(&data),
+            "--images",
+            n,
+            "--size",
+            "16",
+            "--spp",
+            "2",
+            "--seed",
+            "4",
+        ])
+    };
+    render("4");
+    let first = std::fs::read(set.join("img-000001.png")).unwrap();
+    std::fs::remove_file(set.join("img-000001.png")).unwrap();
+    let out = render("6");
+    assert!(util::stdout(&out).contains("3 rendered"), "{}", util::stdout(&out));
+    assert_eq!(std::fs::read(set.join("img-000001.png")).unwrap(), first, "deterministic");
+    // Other settings into the same folder are refused; a fold leaves its materials out.
+    let other = util::run_in(
+        dir.path(),
+        &[
+            "render-set",
+            "--out",
+            &s(&set),
+            "--data",
+            &s(&data),
+            "--images",
+            "6",
+            "--size",
+            "16",
+            "--spp",
+            "3",
+        ],
+    );
+    util::assert_clean_failure(&other, "other settings");
+    let held = dir.path().join("held");
+    ok(&[
+        "render-set",
+        "--out",
+        &s(&held),
+        "--data",
+        &s(&data),
+        "--images",
+        "2",
+        "--size",
+        "16",
+        "--spp",
+        "2",
+        "--exclude-fold",
+        "0/3",
+    ]);
+    let manifest = std::fs::read_to_string(held.join("manifest.json")).unwrap();
+    let bad_fold = util::run_in(
+        dir.path(),
+        &[
+            "render-set",
+            "--out",
+            &s(&dir.path().join("x")),
+            "--data",
+            &s(&data),
+            "--exclude-fold",
+            "3/3",
+        ],
+    );
+    util::assert_clean_failure(&bad_fold, "I/N");
+    assert!(manifest.contains("\"excluded\":[\"") && !manifest.contains("\"excluded\":[]"));
+
+    let run = dir.path().join("cnn");
+    let out = ok(&[
+        "train-recovery",
+        "--model",
+        &s(&model),
+        "--set",
+        &s(&set),
+        "--out",
+        &s(&run),
+        "--epochs",
+        "2",
+    ]);
+    assert!(util::stdout(&out).contains("recovery CNN"), "{}", util::stdout(&out));
+    let net = run.join("recovery");
+    assert!(net.join("recovery.json").is_file());
+    let recovered = dir.path().join("r.binary");
+    let compare = dir.path().join("c.png");
+    let image = s(&set.join("img-000002.png"));
+    ok(&[
+        "recover",
+        "--model",
+        &s(&model),
+        "--network",
+        &s(&net),
+        &image,
+        "-o",
+        &s(&recovered),
+        "--render",
+        &s(&compare),
+    ]);
+    assert_eq!(read_merl(&recovered).unwrap().mask(), util::material(0).mask());
+    assert!(compare.is_file());
+
+    // Unusable photos: blank, not an image.
+    let blank = dir.path().join("blank.png");
+    deepbrdf_render::Srgb8Image::filled(32, 32, [0, 0, 0]).write_png(&blank).unwrap();
+    let o = util::run_in(
+        dir.path(),
+        &[
+            "recover",
+            "--model",
+            &s(&model),
+            "--network",
+            &s(&net),
+            &s(&blank),
+            "-o",
+            &s(&recovered),
+        ],
+    );
+    util::assert_clean_failure(&o, "blank");
+    let junk = dir.path().join("junk.jpg");
+    std::fs::write(&junk, b"no jpeg here").unwrap();
+    let o = util::run_in(
+        dir.path(),
+        &["recover", "--model", &s(&model), "--network", &s(&net), &s(&junk), "-o", &s(&recovered)],
+    );
+    util::assert_clean_failure(&o, "junk.jpg");
+    // A network trained for another model is refused.
+    let other_model = dir.path().join("model2");
+    ok(&[
+        "train",
+        "--config",
+        &s(&config_path),
+        "--data",
+        &s(&data),
+        "--out",
+        &s(&other_model),
+        "--seed",
+        "9",
+    ]);
+    let o = util::run_in(
+        dir.path(),
+        &[
+            "recover",
+            "--model",
+            &s(&other_model),
+            "--network",
+            &s(&net),
+            &image,
+            "-o",
+            &s(&recovered),
+        ],
+    );
+    util::assert_clean_failure(&o, "train-recovery");
+}
