@@ -33,6 +33,11 @@ fn train_encode_decode_and_reconstruct_a_spectral_model() {
     let latent = dir.path().join("m1.json");
     ok(&["encode", &s(&run), &m1, "-o", &s(&latent)]);
     assert!(std::fs::read_to_string(&latent).unwrap().contains(','), "two latent values");
+    // `--model DIR` is the same model as the positional form; both at once are refused.
+    let positional = ok(&["encode", &s(&run), &m1]).stdout;
+    assert_eq!(ok(&["encode", "--model", &s(&run), &m1]).stdout, positional);
+    let out = util::run_in(dir.path(), &["encode", "--model", &s(&run), &s(&run), &m1]);
+    util::assert_clean_failure(&out, "give the model once");
     let decoded_path = dir.path().join("m1-decoded.binary");
     ok(&["decode", &s(&run), &s(&latent), "-o", &s(&decoded_path)]);
     let original = util::material(1);

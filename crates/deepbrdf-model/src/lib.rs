@@ -1,7 +1,8 @@
 //! `deepbrdf-model`: the DeepBRDF networks on Burn (Hu et al., CGF 2020, §3.2).
 //!
-//! - [`autoencoder`]: the architectures, Table 1 and the CPU preset's spectral network
-//!   ([`spectral`], [`principal`]); [`loss`]: eq. (4).
+//! - [`autoencoder`]: the architectures, Table 1, the CPU preset's spectral network
+//!   ([`spectral`], [`principal`]) and the shipped `slice` preset's network shared across phi_d
+//!   slices ([`slice_basis`]); [`loss`]: eq. (4); [`augmentation`]: extra training BRDFs.
 //! - [`train`]: one training loop for every network (schedule, seeded batches, checkpoints
 //!   that resume exactly, NaN stop, CSV log), and the autoencoder's step through it;
 //!   [`training_set`]: the mapped layouts it trains on.
@@ -10,6 +11,7 @@
 //! - [`fit`]: all of the above on a set of MERL tables.
 //! - [`recovery`]: single-image recovery (§5.2): the CNN from a photo to the latent, Fig. 15.
 pub mod artifact;
+pub mod augmentation;
 mod atomic;
 pub mod autoencoder;
 pub mod codec;
@@ -25,6 +27,7 @@ pub mod regressor;
 mod record;
 pub mod recovery;
 pub mod seeded;
+pub mod slice_basis;
 pub mod spectral;
 pub mod timing;
 pub mod train;

@@ -1,4 +1,5 @@
-//! Named settings: `paper` (Table 1 and §3.2's training) and `cpu` (sized for a 2-core CPU).
+//! Named settings: `paper` (Table 1 and §3.2's training), `cpu` (sized for a 2-core CPU) and
+//! `slice` (the network shared across phi_d slices that ships as the default model).
 
 use std::fmt;
 use std::str::FromStr;
@@ -15,17 +16,21 @@ pub enum Preset {
     Cpu,
     /// The paper: Table 1, Adam lr 2e-5, batches of 32, 1000 epochs (for GPUs).
     Paper,
+    /// One basis and one decoder MLP shared by all phi_d slices, small enough to ship: see
+    /// [`crate::AutoencoderConfig::slice`] and [`TrainConfig::slice`].
+    Slice,
 }
 
 impl Preset {
     /// Both presets.
-    pub const ALL: [Preset; 2] = [Preset::Cpu, Preset::Paper];
+    pub const ALL: [Preset; 3] = [Preset::Cpu, Preset::Paper, Preset::Slice];
 
     /// The preset's training configuration for latent dimension `k`.
     pub fn train_config(self, k: usize) -> TrainConfig {
         match self {
             Preset::Cpu => TrainConfig::cpu(k),
             Preset::Paper => TrainConfig::paper(k),
+            Preset::Slice => TrainConfig::slice(k),
         }
     }
 
@@ -34,6 +39,7 @@ impl Preset {
         match self {
             Preset::Cpu => "cpu",
             Preset::Paper => "paper",
+            Preset::Slice => "slice",
         }
     }
 }
@@ -51,6 +57,6 @@ impl FromStr for Preset {
         Self::ALL
             .into_iter()
             .find(|p| p.name().eq_ignore_ascii_case(s.trim()))
-            .ok_or_else(|| format!("unknown preset '{s}': expected cpu or paper"))
+            .ok_or_else(|| format!("unknown preset '{s}': expected cpu, paper or slice"))
     }
 }

@@ -50,13 +50,7 @@ impl SpectralPath {
         allocate_basis: bool,
         device: &Device,
     ) -> Self {
-        let mlp = |from: usize, to: usize| -> Vec<Linear> {
-            let Some(h) = hidden else { return Vec::new() };
-            let layer = |a: usize, b: usize, init: &Initializer| {
-                LinearConfig::new(a, b).with_initializer(init.clone()).init(device)
-            };
-            vec![layer(from, h, init), layer(h, h, init), layer(h, to, &Initializer::Zeros)]
-        };
+        let mlp = |from: usize, to: usize| mlp_layers(from, hidden, to, init, device);
         Self {
             basis: allocate_basis.then(|| {
                 Param::from_tensor(Tensor::zeros([size, INPUT_VALUES], device))
@@ -118,15 +112,7 @@ impl SpectralPath {
     }
 
     fn mlp(&self, layers: &[Linear], x: Tensor<2>) -> Option<Tensor<2>> {
-        let last = layers.len().checked_sub(1)?;
-        let mut x = x;
-        for (i, layer) in layers.iter().enumerate() {
-            x = layer.forward(x);
-            if i < last {
-                x = leaky_relu(x, self.negative_slope);
-            }
-        }
-        Some(x)
+        mlp_forward(layers, x, self.negative_slope)
     }
 
     /// `U (x - mu)`.
@@ -175,6 +161,35 @@ impl SpectralPath {
     pub fn expand(&self, coefficients: Tensor<2>) -> Tensor<2> {
         coefficients.matmul(self.basis()) // [batch, 540*90*90]
     }
+}
+
+/// Three linear layers `from -> hidden -> hidden -> to`, the hidden ones from `init`, the last
+/// at zero (none without `hidden`): the MLPs of the spectral and slice networks.
+pub(crate) fn mlp_layers(
+    from: usize,
+    hidden: Option<usize>,
+    to: usize,
+    init: &Initializer,
+    device: &Device,
+) -> Vec<Linear> {
+    let Some(h) = hidden else { return Vec::new() };
+    let layer = |a: usize, b: usize, init: &Initializer| {
+        LinearConfig::new(a, b).with_initializer(init.clone()).init(device)
+    };
+    vec![layer(from, h, init), layer(h, h, init), layer(h, to, &Initializer::Zeros)]
+}
+
+/// `layers` applied in turn with leaky ReLUs between them; `None` without layers.
+pub(crate) fn mlp_forward(layers: &[Linear], x: Tensor<2>, slope: f64) -> Option<Tensor<2>> {
+    let last = layers.len().checked_sub(1)?;
+    let mut x = x;
+    for (i, layer) in layers.iter().enumerate() {
+        x = layer.forward(x);
+        if i < last {
+            x = leaky_relu(x, slope);
+        }
+    }
+    Some(x)
 }
 
 fn taken() -> ModelError {

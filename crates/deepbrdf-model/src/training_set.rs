@@ -23,6 +23,9 @@ pub struct TrainingSet {
     inputs: Vec<Vec<f32>>,
     masks: Vec<Arc<Vec<f32>>>,
     valid: Vec<f64>,
+    /// The eq. (1) reference in layout order, for a set built from tables (augmentation maps
+    /// through it, [`crate::augmentation`]).
+    reference: Option<Arc<Vec<f32>>>,
 }
 
 impl TrainingSet {
@@ -47,7 +50,7 @@ impl TrainingSet {
                 })
             })
             .collect();
-        Self::from_parts(label.into(), names, inputs, masks)
+        Self::from_parts(label.into(), names, inputs, masks, None)
     }
 
     fn from_parts(
@@ -55,6 +58,7 @@ impl TrainingSet {
         names: Vec<String>,
         inputs: Vec<Vec<f32>>,
         masks: Vec<Arc<Vec<f32>>>,
+        reference: Option<Arc<Vec<f32>>>,
     ) -> Result<Self> {
         if names.is_empty() {
             return Err(ModelError::Invalid("a training set needs at least one BRDF".into()));
@@ -94,7 +98,7 @@ impl TrainingSet {
                 None => valid.push(mask.iter().map(|&m| f64::from(m)).sum()),
             }
         }
-        Ok(Self { label, names, inputs, masks, valid })
+        Ok(Self { label, names, inputs, masks, valid, reference })
     }
 
     /// Maps `tables` with eq. (1) relative to `reference` and reorders them into the §3.2
@@ -130,7 +134,14 @@ impl TrainingSet {
                 }
             })
             .collect();
-        Self::from_parts(label.into(), names.to_vec(), inputs, masks)
+        let reference = Some(Arc::new(to_layout(reference.values())));
+        Self::from_parts(label.into(), names.to_vec(), inputs, masks, reference)
+    }
+
+    /// The eq. (1) reference the set was mapped with, in layout order (sets built from
+    /// tables only).
+    pub fn reference_layout(&self) -> Option<&[f32]> {
+        self.reference.as_deref().map(Vec::as_slice)
     }
 
     /// The data source's label.
@@ -153,7 +164,7 @@ impl TrainingSet {
         self.names.is_empty()
     }
 
-    /// The mapped layout of BRDF `i`.
+    /// The mapped layout of BRDF `i` (invalid cells 0).
     pub fn input(&self, i: usize) -> &[f32] {
         &self.inputs[i]
     }

@@ -1,12 +1,15 @@
-//! The `--model DIR` option of the commands that use a trained DeepBRDF model (`edit`,
-//! `interpolate`, `recover`, ...): a model's artifact directory (or the training directory
-//! holding `model/`), the shipped default model when not given.
+//! The `--model DIR` option of the commands that use a trained DeepBRDF model (`encode`,
+//! `decode`, `reconstruct`, `edit`, `interpolate`, `recover`, ...): a model's artifact directory
+//! (or the training directory holding `model/`), the shipped default model when not given.
+//! `encode`, `decode` and `reconstruct` also keep their earlier form with the model as first
+//! positional argument ([`ModelArg::with_positional`]).
 use anyhow::bail;
 use std::path::{Path, PathBuf};
 
-/// The shipped default model, `models/default/` at the repository root: the autoencoder
-/// artifact as `experiments train` saves it, with the networks trained for it beside it
-/// (`regressor/` for editing, `recovery/` for single-image recovery).
+/// The shipped default model, `models/default/` at the repository root: the training directory
+/// of `experiments train --preset slice` (the autoencoder artifact in `model/`, its log and
+/// configuration), with the networks trained for it beside it (`regressor/` for editing,
+/// `recovery/` for single-image recovery).
 pub const DEFAULT_MODEL_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../models/default");
 
 #[derive(Debug, Clone, clap::Args)]
@@ -38,6 +41,26 @@ impl ModelArg {
                 }
                 Ok(dir.to_path_buf())
             }
+        }
+    }
+
+    /// The model and the input of a command written `[MODEL] INPUT`: with two positionals the
+    /// first is the model (the earlier form; then `--model` must not be given too), with one
+    /// the model is [`dir`](Self::dir).
+    pub fn with_positional(&self, positionals: &[String]) -> anyhow::Result<(PathBuf, String)> {
+        match positionals {
+            [input] => Ok((self.dir()?, input.clone())),
+            [model, input] => {
+                if self.model.is_some() {
+                    bail!("give the model once: as --model DIR or as the first argument");
+                }
+                let dir = PathBuf::from(model);
+                if !dir.exists() {
+                    bail!("model directory {} does not exist", dir.display());
+                }
+                Ok((dir, input.clone()))
+            }
+            _ => bail!("expected [MODEL] INPUT, got {} arguments", positionals.len()),
         }
     }
 }

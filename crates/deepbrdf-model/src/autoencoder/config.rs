@@ -10,7 +10,9 @@ use serde::{Deserialize, Serialize};
 
 use super::convolutional::Convolutional;
 use super::legacy;
+use super::slice_network::SliceNetwork;
 use super::spectral_network::SpectralNetwork;
+use crate::augmentation::AugmentationConfig;
 use super::Autoencoder;
 use crate::error::ModelError;
 
@@ -56,6 +58,9 @@ pub enum Architecture {
     /// The `cpu` preset: MLPs on the coordinates in the training set's principal directions
     /// ([`crate::spectral`]), around the fixed training mean.
     Spectral(SpectralConfig),
+    /// The `slice` preset: one basis for the (theta_h, theta_d) images of every phi_d slice and
+    /// colour, a decoder MLP shared by the slices ([`super::slice_network`]).
+    Slice(SliceConfig),
 }
 
 /// The layers of Table 1's convolutional network.
@@ -100,6 +105,32 @@ pub struct SpectralConfig {
     pub he_init: bool,
 }
 
+/// The `slice` preset's network ([`super::slice_network`], issue 13; not in the paper).
+#[derive(Config, Debug, PartialEq)]
+pub struct SliceConfig {
+    /// M, the directions of the basis shared by the 540 images of a BRDF.
+    #[config(default = 64)]
+    pub directions: usize,
+    /// K >= k, the principal components of the coefficient vectors the encoder MLP sees (the
+    /// first k are the linear path).
+    #[config(default = 40)]
+    pub components: usize,
+    /// Width of the encoder MLP and of the decoder MLP shared by the slices (none: linear,
+    /// PCA within the slice basis' span).
+    #[config(default = "Some(128)")]
+    pub hidden: Option<usize>,
+    /// H, the Fourier harmonics of phi_d the decoder MLP sees.
+    #[config(default = 4)]
+    pub harmonics: usize,
+    /// Extra training BRDFs (channel permutations, mixtures), used by the fits of the mean
+    /// and components and by training.
+    #[config(default = "AugmentationConfig::new()")]
+    pub augmentation: AugmentationConfig,
+}
+
+/// M of the `slice` preset.
+pub const SLICE_DIRECTIONS: usize = 64;
+
 /// Largest layer width, latent dimension or basis size accepted (a guard against typos that
 /// would allocate terabytes).
 const MAX_WIDTH: usize = 4096;
@@ -139,6 +170,31 @@ impl AutoencoderConfig {
         )
     }
 
+    /// The `slice` preset ([`super::slice_network`]): a basis of [`SLICE_DIRECTIONS`]
+    /// directions shared by all phi_d slices and colours, max(40, k) principal components of
+    /// the coefficients, MLPs of width 128, the decoder's shared by the slices; trained with
+    /// channel permutations and pairwise mixtures of the training BRDFs
+    /// ([`AugmentationConfig`]). The whole network is ~2 M values: it ships.
+    pub fn slice(k: usize) -> Self {
+        Self::new(
+            k,
+            Architecture::Slice(
+                SliceConfig::new()
+                    .with_directions(SLICE_DIRECTIONS)
+                    .with_components(k.max(40))
+                    .with_augmentation(AugmentationConfig::preset()),
+            ),
+        )
+    }
+
+    /// The slice network's settings, if it is one.
+    pub fn slice_config(&self) -> Option<&SliceConfig> {
+        match &self.architecture {
+            Architecture::Slice(s) => Some(s),
+            _ => None,
+        }
+    }
+
     /// A spectral network ([`crate::spectral`]): latent dimension `k`, `size` principal
     /// directions, coefficient-space MLPs of width `hidden` (none: linear).
     /// [`cpu`](Self::cpu) is one, with sizes chosen for the MERL collection.
@@ -150,7 +206,7 @@ impl AutoencoderConfig {
     pub fn spectral_config(&self) -> Option<&SpectralConfig> {
         match &self.architecture {
             Architecture::Spectral(s) => Some(s),
-            Architecture::Convolutional(_) => None,
+            Architecture::Convolutional(_) | Architecture::Slice(_) => None,
         }
     }
 
@@ -167,6 +223,7 @@ impl AutoencoderConfig {
         match &self.architecture {
             Architecture::Spectral(_) => true,
             Architecture::Convolutional(c) => c.mean_offset,
+            Architecture::Slice(_) => false,
         }
     }
 
@@ -230,6 +287,27 @@ impl AutoencoderConfig {
                     )));
                 }
             }
+            Architecture::Slice(s) => {
+                if s.directions == 0 || s.directions > 1024 {
+                    return Err(ModelError::Invalid(format!(
+                        "a slice basis of {} directions is out of range (1 to 1024)",
+                        s.directions
+                    )));
+                }
+                if s.components < self.latent || s.components > MAX_WIDTH {
+                    return Err(ModelError::Invalid(format!(
+                        "{} principal components for k = {} (need k to {MAX_WIDTH})",
+                        s.components, self.latent
+                    )));
+                }
+                if s.hidden.is_some_and(|h| h == 0 || h > MAX_WIDTH) || s.harmonics > 64 {
+                    return Err(ModelError::Invalid(format!(
+                        "a slice MLP width of {:?} or {} harmonics is out of range",
+                        s.hidden, s.harmonics
+                    )));
+                }
+                s.augmentation.validate()?;
+            }
         }
         Ok(())
     }
@@ -263,6 +341,7 @@ impl AutoencoderConfig {
             Architecture::Spectral(s) => {
                 Autoencoder::Spectral(SpectralNetwork::new(self, s, allocate_basis, device))
             }
+            Architecture::Slice(s) => Autoencoder::Slice(SliceNetwork::new(self, s, device)),
         };
         // Burn initialises parameters lazily, on first use, from the device's random generator;
         // drawing them all now, in a fixed order, keeps a seeded run reproducible even when the

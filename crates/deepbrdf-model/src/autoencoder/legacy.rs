@@ -109,6 +109,7 @@ fn variant(config: &AutoencoderConfig) -> &'static str {
     match config.architecture {
         Architecture::Convolutional(_) => "Convolutional",
         Architecture::Spectral(_) => "Spectral",
+        Architecture::Slice(_) => "Slice",
     }
 }
 

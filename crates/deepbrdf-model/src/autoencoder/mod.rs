@@ -12,10 +12,14 @@
 //!   ([`AutoencoderConfig::cpu`]), not a CNN: MLPs on the coordinates of the input in the
 //!   training set's leading principal directions, around the training mean
 //!   ([`crate::spectral`]; the README says why and what it costs).
+//! - [`Autoencoder::Slice`] ([`slice_network`]): the `slice` preset
+//!   ([`AutoencoderConfig::slice`]): one basis for the images of all phi_d slices, a decoder
+//!   MLP shared by the slices; small enough to ship.
 
 mod config;
 pub mod convolutional;
 pub(crate) mod legacy;
+pub mod slice_network;
 pub mod spectral_network;
 
 use burn::module::Param;
@@ -25,10 +29,11 @@ use deepbrdf_data::layout::{SIDE, SLICE_CHANNELS};
 use deepbrdf_data::merl::VALUES;
 
 pub use config::{
-    Architecture, AutoencoderConfig, ConvolutionalConfig, SpectralConfig, CPU_SPECTRAL_BASIS,
-    CPU_SPECTRAL_HIDDEN,
+    Architecture, AutoencoderConfig, ConvolutionalConfig, SliceConfig, SpectralConfig,
+    CPU_SPECTRAL_BASIS, CPU_SPECTRAL_HIDDEN, SLICE_DIRECTIONS,
 };
 use convolutional::Convolutional;
+use slice_network::SliceNetwork;
 use spectral_network::SpectralNetwork;
 
 use crate::error::ModelError;
@@ -50,6 +55,8 @@ pub enum Autoencoder {
     Convolutional(Convolutional),
     /// The `cpu` preset's network on spectral coordinates.
     Spectral(SpectralNetwork),
+    /// The `slice` preset's network shared across phi_d slices.
+    Slice(SliceNetwork),
 }
 
 /// A zero offset (set with [`Autoencoder::with_offset`]), not trained.
@@ -63,6 +70,7 @@ impl Autoencoder {
         match self {
             Self::Convolutional(c) => c.offset.as_ref(),
             Self::Spectral(s) => Some(&s.offset),
+            Self::Slice(_) => None,
         }
     }
 
@@ -96,6 +104,9 @@ impl Autoencoder {
                 s.offset = set(s.offset);
                 Ok(Self::Spectral(s))
             }
+            Self::Slice(_) => {
+                Err(ModelError::Invalid("the slice network has no per-value offset".into()))
+            }
         }
     }
 
@@ -107,9 +118,30 @@ impl Autoencoder {
                 s.spectral = s.spectral.with_basis(rows)?;
                 Ok(Self::Spectral(s))
             }
-            Self::Convolutional(_) => {
+            Self::Convolutional(_) | Self::Slice(_) => {
                 Err(ModelError::Invalid("this configuration has no spectral path".into()))
             }
+        }
+    }
+
+    /// The slice network, if the network is one.
+    pub fn slice(&self) -> Option<&SliceNetwork> {
+        match self {
+            Self::Slice(s) => Some(s),
+            _ => None,
+        }
+    }
+
+    /// Sets the slice network's fixed parts ([`SliceNetwork::with_fit`]).
+    pub fn with_slice_fit(
+        self,
+        basis: &[f32],
+        mean: &[f32],
+        components: &[f32],
+    ) -> crate::error::Result<Self> {
+        match self {
+            Self::Slice(s) => Ok(Self::Slice(s.with_fit(basis, mean, components)?)),
+            _ => Err(ModelError::Invalid("this configuration is not a slice network".into())),
         }
     }
 
@@ -117,7 +149,7 @@ impl Autoencoder {
     pub fn spectral(&self) -> Option<&SpectralPath> {
         match self {
             Self::Spectral(s) => Some(&s.spectral),
-            Self::Convolutional(_) => None,
+            Self::Convolutional(_) | Self::Slice(_) => None,
         }
     }
 
@@ -125,7 +157,7 @@ impl Autoencoder {
     pub(crate) fn spectral_mut(&mut self) -> Option<&mut SpectralPath> {
         match self {
             Self::Spectral(s) => Some(&mut s.spectral),
-            Self::Convolutional(_) => None,
+            Self::Convolutional(_) | Self::Slice(_) => None,
         }
     }
 
@@ -134,6 +166,7 @@ impl Autoencoder {
         match self {
             Self::Convolutional(c) => c.latent,
             Self::Spectral(s) => s.spectral.latent(),
+            Self::Slice(s) => s.latent(),
         }
     }
 
@@ -161,6 +194,7 @@ impl Autoencoder {
         match self {
             Self::Convolutional(c) => c.encode_centred(centred),
             Self::Spectral(s) => s.encode_centred(centred),
+            Self::Slice(s) => s.encode_centred(centred),
         }
     }
 
@@ -187,6 +221,7 @@ impl Autoencoder {
         match self {
             Self::Convolutional(c) => c.decode_deviation(latent),
             Self::Spectral(s) => s.decode_deviation(latent),
+            Self::Slice(s) => s.decode_deviation(latent),
         }
     }
 

@@ -2,6 +2,7 @@
 //! evaluation harness: fit, encode/decode every material at each k, measure, print the summary
 //! table and write the results folder (CSV, markdown, Fig. 3 / Fig. 7 style plots).
 use crate::data_args::{cache_at, DataArgs};
+use crate::deep_method::DeepMethod;
 use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::dataset::{DataSource, Dataset};
@@ -37,9 +38,16 @@ pub struct Args {
     #[arg(long, value_delimiter = ',', default_value = "mapped_mse,cos_rmse")]
     pub measures: Vec<Measure>,
     /// Methods (comma-separated): pca, ipca, ggx (the 7-number Lambertian + GGX attribute fit,
-    /// `deepbrdf_eval::attributes`; needs --k 7).
+    /// `deepbrdf_eval::attributes`; needs --k 7), deepbrdf (trained with --preset into
+    /// --models, or loaded from there when finished).
     #[arg(long, value_name = "NAME,...", value_delimiter = ',', default_value = "pca,ipca")]
     pub methods: Vec<String>,
+    /// The preset of the deepbrdf method.
+    #[arg(long, default_value = "slice")]
+    pub preset: deepbrdf_model::Preset,
+    /// Where the deepbrdf method trains its models (`fold<F>/k<K>`) [default: <out>/models].
+    #[arg(long, value_name = "DIR")]
+    pub models: Option<PathBuf>,
     /// Generalize mode: the bundled collections to evaluate on (comma-separated).
     #[arg(long, value_name = "NAME,...", value_delimiter = ',', default_value = "nielsen2015,rgl")]
     pub eval_collections: Vec<Collection>,
@@ -75,8 +83,8 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         bail!("--eval-collections is for generalize mode only");
     }
     for m in &args.methods {
-        if !["pca", "ipca", "ggx"].contains(&m.as_str()) {
-            bail!("unknown method '{m}' (pca, ipca, ggx)");
+        if !["pca", "ipca", "ggx", "deepbrdf"].contains(&m.as_str()) {
+            bail!("unknown method '{m}' (pca, ipca, ggx, deepbrdf)");
         }
     }
     if args.methods.iter().any(|m| m == "ggx") && args.ks != [7] {
@@ -123,12 +131,22 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let train_label = format!("{} ({} materials)", train.label, train.len());
     let eval_label = eval.as_ref().map(|e| format!("{} ({} materials)", e.label, e.len()));
     let ggx = AttributeMethod::default();
+    let preset = args.preset;
+    let models = args.models.clone().unwrap_or_else(|| out.join("models"));
+    let deep = DeepMethod::new(
+        Box::new(move |k| preset.train_config(k)),
+        &models,
+        &train.label,
+        crate::device_arg::device()?,
+    )
+    .retaining(&[]);
     let methods: Vec<&dyn Method> = args
         .methods
         .iter()
         .map(|m| match m.as_str() {
             "pca" => &pca as &dyn Method,
             "ipca" => &ipca,
+            "deepbrdf" => &deep,
             _ => &ggx,
         })
         .collect();

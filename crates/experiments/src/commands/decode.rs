@@ -1,4 +1,4 @@
-//! `experiments decode MODEL latent.json -o out.binary`: the full MERL table of a latent vector
+//! `experiments decode [--model DIR] latent.json -o out.binary`: the full MERL table of a latent vector
 //! (eq. 3), written as a MERL .binary file any renderer reads.
 use crate::latent_file::LatentFile;
 use anyhow::bail;
@@ -9,10 +9,12 @@ use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// A trained model: its artifact directory or the training directory holding `model/`.
-    pub model: PathBuf,
-    /// A latent vector written by `experiments encode -o`.
-    pub latent: PathBuf,
+    /// [MODEL] LATENT: a latent vector written by `experiments encode -o`; before it, optionally, a trained
+    /// model (the earlier form of `--model DIR`).
+    #[arg(value_name = "[MODEL] LATENT", num_args = 1..=2, required = true)]
+    pub inputs: Vec<String>,
+    #[command(flatten)]
+    pub model: crate::model_arg::ModelArg,
     /// The MERL .binary file to write.
     #[arg(short, long, value_name = "FILE")]
     pub output: PathBuf,
@@ -23,15 +25,16 @@ pub struct Args {
 
 pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     let device = crate::device_arg::device()?;
-    let model = DeepBrdf::load(&args.model, &device)?;
-    let latent = LatentFile::load(&args.latent)?;
+    let (model_dir, input) = args.model.with_positional(&args.inputs)?;
+    let model = DeepBrdf::load(&model_dir, &device)?;
+    let latent = LatentFile::load(std::path::Path::new(&input))?;
     if latent.model_id != model.id() && !args.force {
         bail!(
             "{}: this latent vector was made by model {}, not by {} (model {}); pass --force to \
              decode it anyway",
-            args.latent.display(),
+            input,
             latent.model_id,
-            args.model.display(),
+            model_dir.display(),
             model.id()
         );
     }

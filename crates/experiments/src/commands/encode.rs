@@ -1,4 +1,4 @@
-//! `experiments encode MODEL FILE_OR_MATERIAL [-o latent.json]`: the k latent values of a BRDF
+//! `experiments encode [--model DIR] FILE_OR_MATERIAL [-o latent.json]`: the k latent values of a BRDF
 //! (eq. 2).
 use crate::latent_file::LatentFile;
 use anyhow::Context;
@@ -9,10 +9,12 @@ use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// A trained model: its artifact directory or the training directory holding `model/`.
-    pub model: PathBuf,
-    /// A MERL .binary file or the name of a bundled material.
-    pub material: String,
+    /// [MODEL] MATERIAL: a MERL .binary file or the name of a bundled material; before it, optionally, a trained
+    /// model (the earlier form of `--model DIR`).
+    #[arg(value_name = "[MODEL] MATERIAL", num_args = 1..=2, required = true)]
+    pub inputs: Vec<String>,
+    #[command(flatten)]
+    pub model: crate::model_arg::ModelArg,
     /// Write the latent vector (with the model's id) to this JSON file.
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
@@ -22,9 +24,10 @@ pub struct Args {
 
 pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     let device = crate::device_arg::device()?;
-    let model = DeepBrdf::load(&args.model, &device)?;
-    let (name, table) = load_material(&args.material, &args.cache.cache())
-        .with_context(|| format!("cannot read {}", args.material))?;
+    let (model_dir, input) = args.model.with_positional(&args.inputs)?;
+    let model = DeepBrdf::load(&model_dir, &device)?;
+    let (name, table) = load_material(&input, &args.cache.cache())
+        .with_context(|| format!("cannot read {input}"))?;
     let latent = model.encode(&table)?;
     let text: Vec<String> = latent.iter().map(|v| format!("{v:.6}")).collect();
     println!("{}", text.join(" "));

@@ -1,4 +1,4 @@
-//! `experiments reconstruct MODEL FILE_OR_MATERIAL -o out.binary [--slices 1/3|1/9]`: encode and
+//! `experiments reconstruct [--model DIR] FILE_OR_MATERIAL -o out.binary [--slices 1/3|1/9]`: encode and
 //! decode a BRDF; with `--slices`, from the reduced input of Fig. 2 (every 3rd or 9th phi_d
 //! slice, each missing slice filled from its nearest kept one).
 use anyhow::bail;
@@ -13,10 +13,12 @@ use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// A trained model: its artifact directory or the training directory holding `model/`.
-    pub model: PathBuf,
-    /// A MERL .binary file or the name of a bundled material.
-    pub material: String,
+    /// [MODEL] MATERIAL: a MERL .binary file or the name of a bundled material; before it, optionally, a trained
+    /// model (the earlier form of `--model DIR`).
+    #[arg(value_name = "[MODEL] MATERIAL", num_args = 1..=2, required = true)]
+    pub inputs: Vec<String>,
+    #[command(flatten)]
+    pub model: crate::model_arg::ModelArg,
     /// The MERL .binary file to write.
     #[arg(short, long, value_name = "FILE")]
     pub output: PathBuf,
@@ -42,9 +44,10 @@ fn parse_fraction(s: &str) -> anyhow::Result<SliceSelection> {
 
 pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     let device = crate::device_arg::device()?;
-    let model = DeepBrdf::load(&args.model, &device)?;
-    let (name, table) = load_material(&args.material, &args.cache.cache())
-        .with_context(|| format!("cannot read {}", args.material))?;
+    let (model_dir, input) = args.model.with_positional(&args.inputs)?;
+    let model = DeepBrdf::load(&model_dir, &device)?;
+    let (name, table) = load_material(&input, &args.cache.cache())
+        .with_context(|| format!("cannot read {input}"))?;
     let latent = match &args.slices {
         Some(fraction) => {
             let kept = kept_slices(&parse_fraction(fraction)?, 0);

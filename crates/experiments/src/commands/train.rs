@@ -7,6 +7,8 @@
 //! per epoch.
 use crate::data_args::DataArgs;
 use anyhow::{bail, Context};
+use deepbrdf_data::bundled::Collection;
+use deepbrdf_data::dataset::{DataSource, Dataset};
 use deepbrdf_data::lock::FolderLock;
 use deepbrdf_data::Progress;
 use deepbrdf_model::train::{checkpoint_path, saved_config};
@@ -54,6 +56,11 @@ pub struct Args {
     pub resume: Option<Option<PathBuf>>,
     #[command(flatten)]
     pub data: DataArgs,
+    /// Train on these bundled collections too (comma-separated; their materials are named
+    /// `COLLECTION/NAME`), e.g. `--add-collections nielsen2015,rgl,rgl-measured` for the
+    /// shipped default model.
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    pub add_collections: Vec<Collection>,
 }
 
 fn parse_preset(s: &str) -> Result<Preset, String> {
@@ -134,7 +141,14 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             (out, config, false)
         }
     };
-    let data = args.data.load(progress)?;
+    let mut data = args.data.load(progress)?;
+    for &collection in &args.add_collections {
+        let more = Dataset::load(&DataSource::Bundled(collection), &args.data.cache(), progress)
+            .with_context(|| format!("loading the collection {}", collection.name()))?;
+        data.label = format!("{}+{}", data.label, collection.name());
+        data.names.extend(more.names.iter().map(|n| format!("{}/{n}", collection.name())));
+        data.tables.extend(more.tables);
+    }
     eprintln!(
         "training DeepBRDF k = {} on {} ({} BRDFs), {} epochs of batches of {}, on {kind}",
         config.model.latent,

@@ -79,10 +79,7 @@ pub(crate) fn filled_coefficients(
     for (i, slot) in out.iter_mut().enumerate() {
         let mut rows = vec![0f32; selections.len() * INPUT_VALUES];
         for (s, selection) in selections.iter().enumerate() {
-            let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0xf111_ed5e_u64);
-            rng.set_stream(((i as u64) << 16) | s as u64);
-            let mut filled = data.input(i).to_vec();
-            fill_missing_layout(&mut filled, &kept_slices(selection, rng.random()));
+            let filled = filled_input(data, i, s, selection, seed);
             let row = &mut rows[s * INPUT_VALUES..(s + 1) * INPUT_VALUES];
             centre(row, &filled, data.mask(i), Some(offset));
         }
@@ -97,8 +94,25 @@ pub(crate) fn filled_coefficients(
     Ok(out)
 }
 
+/// BRDF `i` of `data` with only the slices of `selection` (number `s` of the run's selections),
+/// each missing slice filled from its nearest kept one; the kept slices of a random selection
+/// are drawn once per (seed, BRDF, selection). Not masked.
+pub(crate) fn filled_input(
+    data: &TrainingSet,
+    i: usize,
+    s: usize,
+    selection: &SliceSelection,
+    seed: u64,
+) -> Vec<f32> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0xf111_ed5e_u64);
+    rng.set_stream(((i as u64) << 16) | s as u64);
+    let mut filled = data.input(i).to_vec();
+    fill_missing_layout(&mut filled, &kept_slices(selection, rng.random()));
+    filled
+}
+
 /// Writes `(x - offset) * mask` into `out`, in parallel.
-fn centre(out: &mut [f32], x: &[f32], mask: &[f32], offset: Option<&[f32]>) {
+pub(crate) fn centre(out: &mut [f32], x: &[f32], mask: &[f32], offset: Option<&[f32]>) {
     const CHUNK: usize = 1 << 16;
     out.par_chunks_mut(CHUNK).enumerate().for_each(|(c, o)| {
         let range = c * CHUNK..c * CHUNK + o.len();

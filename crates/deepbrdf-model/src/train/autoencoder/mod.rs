@@ -4,6 +4,7 @@
 
 mod batch;
 mod config;
+mod slice_step;
 mod step;
 
 use std::path::Path;
@@ -98,11 +99,12 @@ fn train_in(
     }
     let fingerprint = data.fingerprint();
     let mut step = AutoencoderStep::new(config, data)?;
+    let samples = step.samples();
     let outcome = run(
         &config.loop_config(),
         &identity,
         &fingerprint,
-        data.len(),
+        samples,
         &mut step,
         session,
         device,

@@ -11,6 +11,7 @@ use deepbrdf_data::Progress;
 
 use super::batch::{batch_tensors, filled_coefficients, Augment, Batch};
 use super::config::TrainConfig;
+use super::slice_step::{self, SliceFit};
 use crate::autoencoder::Autoencoder;
 use crate::error::ModelError;
 use crate::loss::masked_mse_centred;
@@ -32,6 +33,8 @@ pub(crate) struct AutoencoderStep<'a> {
     /// With slice dropout on coordinates: the coordinates of the filled inputs,
     /// `[brdf][selection][K]`, computed once.
     dropout_coefficients: Option<Vec<Vec<Vec<f32>>>>,
+    /// A slice network's coefficients of the training samples.
+    slice: Option<SliceFit>,
 }
 
 impl<'a> AutoencoderStep<'a> {
@@ -43,7 +46,23 @@ impl<'a> AutoencoderStep<'a> {
             Some(d) => Some((d.probability, d.parsed()?)),
             None => None,
         };
-        Ok(Self { config, data, dropout, offset: None, fit: None, dropout_coefficients: None })
+        Ok(Self {
+            config,
+            data,
+            dropout,
+            offset: None,
+            fit: None,
+            dropout_coefficients: None,
+            slice: None,
+        })
+    }
+
+    /// The number of training samples: the BRDFs, and the augmentations of a slice network.
+    pub(crate) fn samples(&self) -> usize {
+        match self.config.model.slice_config() {
+            Some(layers) => layers.augmentation.samples(self.data.len()),
+            None => self.data.len(),
+        }
     }
 }
 
@@ -74,6 +93,20 @@ impl TrainStep for AutoencoderStep<'_> {
     ) -> crate::error::Result<Autoencoder> {
         let mut model = model;
         self.offset = model.offset();
+        if let Some(layers) = self.config.model.slice_config() {
+            let selections = self.dropout.as_ref().map(|(_, s)| s.as_slice());
+            let (model, fit) = slice_step::prepare(
+                model,
+                self.data,
+                layers,
+                selections,
+                self.config.seed,
+                fresh,
+                progress,
+            )?;
+            self.slice = Some(fit);
+            return Ok(model);
+        }
         let (Some(spectral), Some(mean)) = (self.config.model.spectral_config(), &self.offset)
         else {
             return Ok(model);
@@ -106,6 +139,20 @@ impl TrainStep for AutoencoderStep<'_> {
             seed: self.config.seed,
             epoch,
         });
+        if let Some(fit) = &self.slice {
+            let n = self.data.len();
+            let inputs: Vec<f32> = indices
+                .iter()
+                .flat_map(|&i| {
+                    let choice = augment.as_ref().filter(|_| i < n).and_then(|a| a.choice(i));
+                    match (&fit.filled, choice) {
+                        (Some(filled), Some(s)) => filled[i][s].clone(),
+                        _ => fit.target(i).to_vec(),
+                    }
+                })
+                .collect();
+            return slice_step::slice_gradients(model, fit, indices, inputs, device);
+        }
         match &self.fit {
             Some(fit) => {
                 let inputs: Vec<f32> = indices

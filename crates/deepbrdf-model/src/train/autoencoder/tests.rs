@@ -291,3 +291,59 @@ fn slice_dropout_fills_inputs_but_keeps_targets() {
     let dropout = SliceDropoutConfig::new().with_selections(vec!["every:0".into()]);
     assert!(dropout.parsed().is_err());
 }
+
+/// [`mixed_set`]'s layouts with every value valid (so the slice network's coefficient loss
+/// is eq. (4) exactly).
+fn valid_set() -> TrainingSet {
+    let set = mixed_set();
+    let inputs = (0..set.len()).map(|i| set.input(i).to_vec()).collect();
+    TrainingSet::from_layouts("valid", set.names().to_vec(), inputs, vec![vec![1.0; INPUT_VALUES]; 4])
+        .unwrap()
+}
+
+fn slice_config(epochs: usize) -> TrainConfig {
+    use crate::augmentation::AugmentationConfig;
+    use crate::autoencoder::{Architecture, SliceConfig};
+    let layers = SliceConfig::new()
+        .with_directions(12)
+        .with_components(3)
+        .with_hidden(Some(16))
+        .with_augmentation(AugmentationConfig::new());
+    TrainConfig::new(AutoencoderConfig::new(1, Architecture::Slice(layers)), adam())
+        .with_learning_rate(1e-2)
+        .with_final_lr_factor(0.05)
+        .with_epochs(epochs)
+        .with_batch_size(2)
+        .with_seed(5)
+        .with_checkpoint_seconds(0.0)
+}
+
+#[test]
+fn slice_training_on_coefficients_matches_the_full_loss_and_resumes() {
+    let set = valid_set();
+    let config = slice_config(60);
+    let dir = tempfile::tempdir().unwrap();
+    let trained = train(&config, &set, dir.path(), false, &Silent, &device()).unwrap();
+    let (first, last) = (trained.log[0].loss, trained.log.last().unwrap().loss);
+    assert!(last < 0.7 * first, "loss {first} -> {last}");
+    let full = trained.mean_mse();
+    assert!((full - last).abs() <= 2e-2 * full, "coefficients {last} vs full {full}");
+    // Killed in epoch 2 of a short run, then resumed: the same run.
+    let short = config.clone().with_epochs(3);
+    let straight_dir = tempfile::tempdir().unwrap();
+    let straight = train(&short, &set, straight_dir.path(), false, &Silent, &device()).unwrap();
+    let killed = tempfile::tempdir().unwrap();
+    let session = Session::new(killed.path(), false, &Silent, "test").killed_after(1, 0);
+    assert!(train_in(&short, &set, &session, &device()).is_err());
+    let resumed = train(&short, &set, killed.path(), true, &Silent, &device()).unwrap();
+    assert_eq!(losses(&resumed), losses(&straight));
+    assert_eq!(resumed.per_material_mse, straight.per_material_mse);
+    // Augmentation needs the set's eq. (1) reference, which a set of layouts lacks.
+    let mut augmented = slice_config(1);
+    if let crate::autoencoder::Architecture::Slice(s) = &mut augmented.model.architecture {
+        s.augmentation = crate::augmentation::AugmentationConfig::preset();
+    }
+    let other = tempfile::tempdir().unwrap();
+    let err = train(&augmented, &set, other.path(), false, &Silent, &device()).unwrap_err();
+    assert!(err.to_string().contains("reference"), "{err}");
+}

@@ -1,0 +1,211 @@
+//! Training-set augmentation in linear BRDF space (not in the paper; issue 13): extra training
+//! BRDFs made from the mapped layouts of a [`TrainingSet`] through the inverse of eq. (1) and
+//! back, with the set's reference.
+//!
+//! - RGB channel permutations (the Neural-BRDF autoencoder's augmentation): each BRDF also in
+//!   the 5 other orders of its colour channels, `rho'_c = rho_pi(c)`.
+//! - Pairwise interpolation (AugMERL, NeuMaDiff): `rho = t rho_a + (1 - t) rho_b` for pairs
+//!   (a, b) and weights t in [1/4, 3/4] drawn from the seed, valid where both are.
+//!
+//! Sample `i < n` is BRDF i itself; the permutations follow (5 per BRDF), then the mixtures.
+
+use burn::config::Config;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+
+use crate::autoencoder::INPUT_VALUES;
+use crate::error::ModelError;
+use crate::training_set::TrainingSet;
+use deepbrdf_data::mapping::{inverse_log_relative, log_relative};
+use deepbrdf_data::merl::N_PHI_D;
+
+/// The orders of the three colour channels; the first is the identity.
+const PERMUTATIONS: [[usize; 3]; 6] =
+    [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
+/// Values of one colour image of the layout.
+const IMAGE: usize = INPUT_VALUES / (3 * N_PHI_D);
+
+/// Which extra BRDFs a training set is augmented with.
+#[derive(Config, Debug, PartialEq)]
+pub struct AugmentationConfig {
+    /// Add every BRDF in the 5 other orders of its colour channels.
+    #[config(default = false)]
+    pub rgb_permutations: bool,
+    /// Pairwise mixtures in linear BRDF space per training BRDF (rounded down; 0: none).
+    #[config(default = 0.0)]
+    pub mixtures_per_brdf: f64,
+}
+
+/// One augmented sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Sample {
+    /// A training BRDF as it is.
+    Original(usize),
+    /// BRDF `index` with its channels in order `PERMUTATIONS[order]`.
+    Permuted { index: usize, order: usize },
+    /// `t a + (1 - t) b`.
+    Mixture { a: usize, b: usize, t: f64 },
+}
+
+impl AugmentationConfig {
+    /// The `slice` preset's: permutations and 4 mixtures per BRDF.
+    pub fn preset() -> Self {
+        Self::new().with_rgb_permutations(true).with_mixtures_per_brdf(4.0)
+    }
+
+    /// Checks the settings.
+    pub fn validate(&self) -> crate::error::Result<()> {
+        if !(0.0..=100.0).contains(&self.mixtures_per_brdf) {
+            return Err(ModelError::Invalid(format!(
+                "{} mixtures per BRDF is out of range (0 to 100)",
+                self.mixtures_per_brdf
+            )));
+        }
+        Ok(())
+    }
+
+    /// Whether no sample is added.
+    pub fn is_none(&self) -> bool {
+        !self.rgb_permutations && self.mixtures(usize::MAX / 1024) == 0
+    }
+
+    fn mixtures(&self, n: usize) -> usize {
+        if n < 2 {
+            return 0;
+        }
+        (self.mixtures_per_brdf * n as f64).floor() as usize
+    }
+
+    /// The number of samples of a set of `n` BRDFs, originals included.
+    pub fn samples(&self, n: usize) -> usize {
+        let permuted = if self.rgb_permutations { 5 * n } else { 0 };
+        n + permuted + self.mixtures(n)
+    }
+
+    /// Sample `i` of a set of `n` BRDFs (`i < samples(n)`), drawn from `seed`.
+    pub fn sample(&self, n: usize, i: usize, seed: u64) -> Sample {
+        if i < n {
+            return Sample::Original(i);
+        }
+        let j = i - n;
+        if self.rgb_permutations && j < 5 * n {
+            return Sample::Permuted { index: j / 5, order: 1 + j % 5 };
+        }
+        let j = if self.rgb_permutations { j - 5 * n } else { j };
+        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0xa06_3e71_u64);
+        rng.set_stream(j as u64);
+        let a = rng.random_range(0..n);
+        let b = (a + rng.random_range(1..n)) % n;
+        let t = rng.random_range(0.25..0.75);
+        Sample::Mixture { a, b, t }
+    }
+}
+
+/// The mapped layout (invalid cells 0) and the number of valid values of `sample` of `data`.
+pub fn sample_layout(data: &TrainingSet, sample: Sample) -> crate::error::Result<(Vec<f32>, f64)> {
+    if let Sample::Original(i) = sample {
+        return Ok((data.input(i).to_vec(), data.valid_values(i)));
+    }
+    let reference = data.reference_layout().ok_or_else(|| {
+        ModelError::Invalid(format!(
+            "{}: augmentation needs the eq. (1) reference of the set (a set built from tables)",
+            data.label()
+        ))
+    })?;
+    let mut out = vec![0f32; INPUT_VALUES];
+    let unmap = |x: f32, r: f32| inverse_log_relative(f64::from(x), f64::from(r));
+    let map = |rho: f64, r: f32| log_relative(rho.max(-deepbrdf_data::mapping::EPSILON), f64::from(r)) as f32;
+    let valid = match sample {
+        Sample::Original(_) => unreachable!("returned above"),
+        Sample::Permuted { index, order } => {
+            let (x, mask) = (data.input(index), data.mask(index));
+            let perm = PERMUTATIONS[order];
+            out.par_chunks_mut(IMAGE).enumerate().for_each(|(image, o)| {
+                let (slice, colour) = (image / 3, image % 3);
+                let from = (slice * 3 + perm[colour]) * IMAGE;
+                let to = image * IMAGE;
+                for (c, v) in o.iter_mut().enumerate() {
+                    if mask[to + c] != 0.0 {
+                        *v = map(unmap(x[from + c], reference[from + c]), reference[to + c]);
+                    }
+                }
+            });
+            data.valid_values(index)
+        }
+        Sample::Mixture { a, b, t } => {
+            let (xa, xb) = (data.input(a), data.input(b));
+            let (ma, mb) = (data.mask(a), data.mask(b));
+            out.par_chunks_mut(IMAGE).enumerate().for_each(|(image, o)| {
+                let start = image * IMAGE;
+                for (c, v) in o.iter_mut().enumerate() {
+                    let i = start + c;
+                    if ma[i] != 0.0 && mb[i] != 0.0 {
+                        let r = reference[i];
+                        *v = map(t * unmap(xa[i], r) + (1.0 - t) * unmap(xb[i], r), r);
+                    }
+                }
+            });
+            ma.iter().zip(mb).filter(|(&p, &q)| p != 0.0 && q != 0.0).count() as f64
+        }
+    };
+    Ok((out, valid))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use deepbrdf_data::mapping::MedianReference;
+    use deepbrdf_data::MerlTable;
+
+    fn set() -> TrainingSet {
+        let a = MerlTable::from_fn(|h, d, _| {
+            let v = 0.05 + 0.001 * (h + d) as f32;
+            [v, 2.0 * v, 3.0 * v]
+        });
+        let b = MerlTable::from_fn(|h, _, p| {
+            let v = 0.2 + 0.002 * h as f32 + 0.0001 * p as f32;
+            [3.0 * v, v, 0.5 * v]
+        });
+        let reference = MedianReference::from_tables(&[&a, &b]).unwrap();
+        TrainingSet::from_tables("t", &["a".into(), "b".into()], &[&a, &b], &reference).unwrap()
+    }
+
+    #[test]
+    fn samples_enumerate_originals_permutations_and_mixtures() {
+        let config = AugmentationConfig::preset();
+        assert_eq!(config.samples(2), 2 + 10 + 8);
+        assert_eq!(config.sample(2, 1, 0), Sample::Original(1));
+        assert_eq!(config.sample(2, 2, 0), Sample::Permuted { index: 0, order: 1 });
+        assert_eq!(config.sample(2, 11, 0), Sample::Permuted { index: 1, order: 5 });
+        let Sample::Mixture { a, b, t } = config.sample(2, 12, 0) else { panic!("a mixture") };
+        assert!(a != b && (0.25..0.75).contains(&t));
+        assert_eq!(config.sample(2, 12, 0), config.sample(2, 12, 0));
+        assert_eq!(AugmentationConfig::new().samples(5), 5);
+        assert!(AugmentationConfig::new().is_none());
+    }
+
+    #[test]
+    fn permutations_and_mixtures_are_computed_in_linear_space() {
+        let data = set();
+        let reference = data.reference_layout().unwrap().to_vec();
+        let linear = |x: &[f32], i: usize| inverse_log_relative(f64::from(x[i]), f64::from(reference[i]));
+        // Slice 7, a valid cell of image (7, colour): red and blue swapped (order [2, 1, 0]).
+        let cell = (0..IMAGE).find(|&c| data.mask(0)[(7 * 3) * IMAGE + c] != 0.0).unwrap();
+        let (swapped, valid) = sample_layout(&data, Sample::Permuted { index: 0, order: 5 }).unwrap();
+        assert_eq!(valid, data.valid_values(0));
+        let red = 7 * 3 * IMAGE + cell;
+        let blue = (7 * 3 + 2) * IMAGE + cell;
+        assert!((linear(&swapped, red) - linear(data.input(0), blue)).abs() < 1e-5);
+        assert!((linear(&swapped, blue) - linear(data.input(0), red)).abs() < 1e-5);
+        let (mixed, _) = sample_layout(&data, Sample::Mixture { a: 0, b: 1, t: 0.25 }).unwrap();
+        let want = 0.25 * linear(data.input(0), red) + 0.75 * linear(data.input(1), red);
+        assert!((linear(&mixed, red) - want).abs() < 1e-5 * want.abs().max(1.0));
+        // Invalid cells stay 0.
+        let invalid = (0..INPUT_VALUES).find(|&i| data.mask(0)[i] == 0.0).unwrap();
+        assert_eq!(mixed[invalid], 0.0);
+        let no_reference =
+            TrainingSet::from_layouts("x", vec!["a".into()], vec![data.input(0).to_vec()], vec![data.mask(0).to_vec()]).unwrap();
+        assert!(sample_layout(&no_reference, Sample::Permuted { index: 0, order: 1 }).is_err());
+    }
+}

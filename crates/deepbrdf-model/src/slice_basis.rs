@@ -1,0 +1,277 @@
+//! The fixed linear parts of the `slice` preset's network ([`crate::autoencoder::slice_network`];
+//! not in the paper, issue 13): one basis of M directions for a single (theta_h, theta_d) image of
+//! the §3.2 layout, shared by all 540 images (180 phi_d slices x 3 colours) of every BRDF, and the
+//! principal components of the BRDFs' coefficients in it.
+//!
+//! - [`fit_slice_basis`]: the M leading principal directions (uncentred, so the mean shape is
+//!   in the span) of the masked mapped images of a training set (every third phi_d slice) (eq. (1) space, invalid
+//!   cells 0), found by randomized subspace iteration (Halko et al. 2011): the 8100 x 8100 second
+//!   moment `sum_i X_i^T X_i` is applied to a block of vectors a few times, never formed. 100
+//!   BRDFs give 54,000 images for 8100 values: a basis learned from many more samples than the
+//!   100 whole tables of the `cpu` preset's basis, and 64 x 8100 values instead of 96 x 4.37 M.
+//! - [`project`]: the 540 x M coefficients of one layout and its squared distance to the span.
+//! - [`fit_components`]: the leading principal directions of the coefficient vectors (the Gram
+//!   route of [`deepbrdf_data::gram_pca`]), the network's linear path: with its MLPs at zero the
+//!   network is PCA in the mapped space restricted to the slice basis' span.
+//!
+//! All sums run in a fixed order: the fits are deterministic bit for bit.
+
+use burn::prelude::*;
+use burn::tensor::TensorData;
+use nalgebra::DMatrix;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+
+use crate::autoencoder::{INPUT_CHANNELS, INPUT_VALUES};
+use crate::error::{ModelError, Result};
+use deepbrdf_data::gram_pca::{leading_eigenpairs, ordered_block_sum};
+
+/// Values of one (theta_h, theta_d) image of the layout (90 x 90).
+pub const SLICE_VALUES: usize = INPUT_VALUES / INPUT_CHANNELS;
+/// Extra vectors of the subspace iteration beyond M (oversampling).
+const OVERSAMPLING: usize = 16;
+/// Applications of the second moment (the last one feeds the Rayleigh-Ritz step).
+const PASSES: usize = 3;
+/// The basis is fitted to the images of every third phi_d slice (18,000 images of 100 BRDFs:
+/// plenty for M directions of 8100 values; neighbouring slices are nearly equal).
+const FIT_SLICE_STRIDE: usize = 3;
+/// BRDFs whose images are multiplied at once.
+const GROUP: usize = 8;
+
+/// A row-major f32 tensor of the column-major `m`.
+fn tensor_of(m: &DMatrix<f64>, device: &Device) -> Tensor<2> {
+    let values: Vec<f32> = m.transpose().iter().map(|&v| v as f32).collect();
+    Tensor::from_data(TensorData::new(values, [m.nrows(), m.ncols()]), device)
+}
+
+/// The images of `layouts` stacked: `[540 * layouts, 8100]`.
+fn images(layouts: &[&[f32]], device: &Device) -> Tensor<2> {
+    let values: Vec<f32> = layouts.iter().flat_map(|l| l.iter().copied()).collect();
+    Tensor::from_data(
+        TensorData::new(values, [INPUT_CHANNELS * layouts.len(), SLICE_VALUES]),
+        device,
+    )
+}
+
+/// The images of every [`FIT_SLICE_STRIDE`]-th slice of `layouts`, stacked.
+fn strided_images(layouts: &[&[f32]], device: &Device) -> Tensor<2> {
+    let slice = 3 * SLICE_VALUES;
+    let values: Vec<f32> = layouts
+        .iter()
+        .flat_map(|l| l.chunks(slice).step_by(FIT_SLICE_STRIDE).flatten().copied())
+        .collect();
+    let rows = values.len() / SLICE_VALUES;
+    Tensor::from_data(TensorData::new(values, [rows, SLICE_VALUES]), device)
+}
+
+fn read(t: Tensor<2>) -> Result<Vec<f32>> {
+    t.into_data()
+        .try_into_vec()
+        .map_err(|e| ModelError::Invalid(format!("reading a tensor back failed: {e:?}")))
+}
+
+/// `sum_i X_i^T (X_i q)` over the layouts, in f64, added group by group in layout order.
+fn second_moment_times(
+    layouts: &[&[f32]],
+    q: &DMatrix<f64>,
+    device: &Device,
+) -> Result<DMatrix<f64>> {
+    let q32 = tensor_of(q, device); // [8100, L]
+    let mut total = DMatrix::<f64>::zeros(q.nrows(), q.ncols());
+    for group in layouts.chunks(GROUP) {
+        let x = strided_images(group, device); // [180 g, 8100]
+        let part = read(x.clone().transpose().matmul(x.matmul(q32.clone())))?; // [8100, L]
+        for (i, v) in part.iter().enumerate() {
+            total[(i / q.ncols(), i % q.ncols())] += f64::from(*v);
+        }
+    }
+    Ok(total)
+}
+
+/// An orthonormal basis of the columns of `y` (thin QR).
+fn orthonormal(y: DMatrix<f64>) -> DMatrix<f64> {
+    y.qr().q()
+}
+
+/// The `m` leading directions of the images of `layouts` (each `540 * 90 * 90` mapped values in
+/// layout order, invalid cells 0): `m` orthonormal rows of [`SLICE_VALUES`] values, row-major.
+pub fn fit_slice_basis(
+    layouts: &[&[f32]],
+    m: usize,
+    seed: u64,
+    device: &Device,
+) -> Result<Vec<f32>> {
+    if layouts.is_empty() || m == 0 || m + OVERSAMPLING > SLICE_VALUES {
+        return Err(ModelError::Invalid(format!(
+            "a slice basis of {m} directions from {} BRDFs",
+            layouts.len()
+        )));
+    }
+    if let Some(i) = layouts.iter().position(|l| l.len() != INPUT_VALUES) {
+        return Err(ModelError::Invalid(format!("layout {i} does not have {INPUT_VALUES} values")));
+    }
+    let width = m + OVERSAMPLING;
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x511c_eba5_15_u64);
+    let start = DMatrix::<f64>::from_fn(SLICE_VALUES, width, |_, _| rng.random_range(-1.0..1.0));
+    let mut q = orthonormal(start);
+    for _ in 1..PASSES {
+        q = orthonormal(second_moment_times(layouts, &q, device)?);
+    }
+    // Rayleigh-Ritz on span(q): the eigenvectors of q^T C q, largest first.
+    let cq = second_moment_times(layouts, &q, device)?;
+    let small = q.transpose() * &cq;
+    let small = (&small + small.transpose()) * 0.5;
+    let eig = nalgebra::SymmetricEigen::try_new(small, 1e-14, 10_000).ok_or_else(|| {
+        ModelError::Invalid("the slice basis' eigendecomposition did not converge".into())
+    })?;
+    let mut order: Vec<usize> = (0..width).collect();
+    order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
+    let mut rows = vec![0f32; m * SLICE_VALUES];
+    for (j, &e) in order.iter().take(m).enumerate() {
+        let direction = &q * eig.eigenvectors.column(e);
+        for (r, v) in rows[j * SLICE_VALUES..(j + 1) * SLICE_VALUES].iter_mut().zip(direction.iter())
+        {
+            *r = *v as f32;
+        }
+    }
+    Ok(rows)
+}
+
+/// The basis rows (`m x 8100`, row-major) as the tensor `B^T` (`[8100, m]`) on `device`.
+pub fn basis_t(basis: &[f32], device: &Device) -> Tensor<2> {
+    let m = basis.len() / SLICE_VALUES;
+    Tensor::<2>::from_data(TensorData::new(basis.to_vec(), [m, SLICE_VALUES]), device).transpose()
+}
+
+/// The coefficients of `layout` in the basis (`basis_t` from [`basis_t`]): 540 x m values,
+/// row-major (image-major, as the layout), and the squared distance of the layout to the span.
+pub fn project(layout: &[f32], basis_t: &Tensor<2>) -> Result<(Vec<f32>, f64)> {
+    let x = images(&[layout], &basis_t.device());
+    let out = read(x.matmul(basis_t.clone()))?; // [540, m]
+    let total: f64 = layout.iter().map(|&v| f64::from(v) * f64::from(v)).sum();
+    let inside: f64 = out.iter().map(|&v| f64::from(v) * f64::from(v)).sum();
+    Ok((out, (total - inside).max(0.0)))
+}
+
+/// The linear path of the network: the mean of the coefficient vectors and their `k` leading
+/// principal directions (`k` rows of the vectors' length, orthonormal; zero past the rank).
+#[derive(Clone, Debug)]
+pub struct Components {
+    /// The per-value mean of the vectors.
+    pub mean: Vec<f32>,
+    /// `k` rows, row-major.
+    pub rows: Vec<f32>,
+}
+
+/// The mean and `k` leading principal directions of `vectors` (all of one length).
+pub fn fit_components(vectors: &[Vec<f32>], k: usize) -> Result<Components> {
+    let n = vectors.len();
+    let len = vectors.first().map_or(0, Vec::len);
+    if n == 0 || k == 0 || vectors.iter().any(|v| v.len() != len) {
+        return Err(ModelError::Invalid(format!(
+            "principal components (k = {k}) of {n} coefficient vectors of unequal or no length"
+        )));
+    }
+    let mut mean = vec![0f64; len];
+    for v in vectors {
+        for (m, &x) in mean.iter_mut().zip(v) {
+            *m += f64::from(x);
+        }
+    }
+    let mean: Vec<f32> = mean.iter().map(|&m| (m / n as f64) as f32).collect();
+    const BLOCK: usize = 4096;
+    let blocks = len.div_ceil(BLOCK);
+    let range = |b: usize| b * BLOCK..((b + 1) * BLOCK).min(len);
+    let centred = |b: usize| {
+        let r = range(b);
+        DMatrix::<f64>::from_fn(n, r.len(), |i, c| {
+            f64::from(vectors[i][r.start + c]) - f64::from(mean[r.start + c])
+        })
+    };
+    let gram = ordered_block_sum(blocks, n, |b| {
+        let x = centred(b);
+        &x * x.transpose()
+    });
+    let pairs = leading_eigenpairs(gram, k)?;
+    let mut w = DMatrix::<f64>::zeros(n, k);
+    for (j, &s) in pairs.sigmas.iter().enumerate() {
+        if s > 0.0 {
+            for i in 0..n {
+                w[(i, j)] = pairs.vectors[(i, j)] / s;
+            }
+        }
+    }
+    let wt = w.transpose();
+    let parts: Vec<DMatrix<f64>> = (0..blocks).into_par_iter().map(|b| &wt * centred(b)).collect();
+    let mut rows = vec![0f32; k * len];
+    for (b, part) in parts.iter().enumerate() {
+        let start = b * BLOCK;
+        for j in 0..k {
+            for c in 0..part.ncols() {
+                rows[j * len + start + c] = part[(j, c)] as f32;
+            }
+        }
+    }
+    Ok(Components { mean, rows })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Layouts whose every image is a mix of two fixed images.
+    fn layouts() -> Vec<Vec<f32>> {
+        let a: Vec<f32> = (0..SLICE_VALUES).map(|i| ((i % 7) as f32 - 3.0) / 3.0).collect();
+        let b: Vec<f32> = (0..SLICE_VALUES).map(|i| ((i % 13) as f32) / 13.0).collect();
+        (0..3)
+            .map(|n| {
+                let mut out = vec![0f32; INPUT_VALUES];
+                for (image, chunk) in out.chunks_mut(SLICE_VALUES).enumerate() {
+                    let (p, q) = (((image + n) % 5) as f32, ((image * 3 + n) % 4) as f32 - 1.5);
+                    for (i, v) in chunk.iter_mut().enumerate() {
+                        *v = p * a[i] + q * b[i];
+                    }
+                }
+                out
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_slice_basis_spans_rank_two_images_and_is_orthonormal() {
+        let data = layouts();
+        let refs: Vec<&[f32]> = data.iter().map(Vec::as_slice).collect();
+        let device = crate::device::DeviceKind::default_kind().unwrap().device().unwrap();
+        let basis = fit_slice_basis(&refs, 3, 7, &device).unwrap();
+        assert_eq!(basis, fit_slice_basis(&refs, 3, 7, &device).unwrap(), "deterministic");
+        let row = |j: usize| &basis[j * SLICE_VALUES..(j + 1) * SLICE_VALUES];
+        let dot = |x: &[f32], y: &[f32]| x.iter().zip(y).map(|(a, b)| f64::from(a * b)).sum::<f64>();
+        for i in 0..3 {
+            for j in 0..3 {
+                let want = if i == j { 1.0 } else { 0.0 };
+                assert!((dot(row(i), row(j)) - want).abs() < 1e-4, "{i} {j}");
+            }
+        }
+        let bt = basis_t(&basis, &device);
+        for layout in &data {
+            let (_, residual) = project(layout, &bt).unwrap();
+            let total: f64 = layout.iter().map(|&v| f64::from(v * v)).sum();
+            assert!(residual < 1e-6 * total, "{residual} of {total}");
+        }
+        assert!(fit_slice_basis(&[], 3, 0, &device).is_err());
+    }
+
+    #[test]
+    fn components_reproduce_rank_one_vectors() {
+        let d: Vec<f32> = (0..10).map(|i| i as f32 - 4.0).collect();
+        let vectors: Vec<Vec<f32>> =
+            [1.0f32, -2.0, 0.5].iter().map(|&t| d.iter().map(|&x| 1.0 + t * x).collect()).collect();
+        let c = fit_components(&vectors, 2).unwrap();
+        let norm: f32 = c.rows[..10].iter().map(|v| v * v).sum();
+        assert!((norm - 1.0).abs() < 1e-5);
+        assert!(c.rows[10..].iter().all(|&v| v == 0.0), "rank one: the second row is zero");
+        assert!((c.mean[0] - (1.0 - 4.0 * (-0.5 / 3.0))).abs() < 1e-5);
+        assert!(fit_components(&[], 1).is_err());
+    }
+}

@@ -1,0 +1,135 @@
+//! The `slice` network's side of the autoencoder's training step
+//! ([`crate::autoencoder::slice_network`]): the fits of its fixed parts (slice basis, mean and
+//! principal components of the coefficients of the training BRDFs and their augmentations) and
+//! the eq. (4) loss of a batch on coefficients.
+//!
+//! For an orthonormal slice basis B, the squared error of an output `B^T a_hat` against a
+//! training layout x is `|a_hat - B x|^2` plus the (fixed) squared distance of x to B's span:
+//! training runs on the 540 x M coefficients of each BRDF, computed once, as the `cpu` preset's
+//! runs on its coordinates. (The output is compared on every cell of each image; the masked
+//! loss of eq. (4) skips the cells invalid in that slice, where the target's projection is
+//! near 0: the coefficient loss bounds it from above.)
+
+use burn::optim::{GradientsParams, MultiGradientsParams};
+use burn::prelude::*;
+use burn::tensor::TensorData;
+use deepbrdf_data::augment::SliceSelection;
+use deepbrdf_data::Progress;
+
+use super::batch::{centre, filled_input};
+use crate::augmentation::sample_layout;
+use crate::autoencoder::{Autoencoder, SliceConfig, INPUT_VALUES};
+use crate::error::ModelError;
+use crate::slice_basis::{basis_t, fit_components, fit_slice_basis, project};
+use crate::train::run::on_device;
+use crate::training_set::TrainingSet;
+
+/// The coefficients of every training sample (the BRDFs, then their augmentations).
+pub(crate) struct SliceFit {
+    /// `[sample][540 * M]`: the targets.
+    targets: Vec<Vec<f32>>,
+    /// Squared distance of each sample's layout to the slice basis' span.
+    residuals: Vec<f64>,
+    /// Valid values of each sample.
+    valid: Vec<f64>,
+    /// With slice dropout: the coefficients of the filled inputs of the BRDFs (not of the
+    /// augmentations), `[brdf][selection][540 * M]`.
+    pub(crate) filled: Option<Vec<Vec<Vec<f32>>>>,
+}
+
+impl SliceFit {
+    /// The target coefficients of sample `i`.
+    pub(crate) fn target(&self, i: usize) -> &[f32] {
+        &self.targets[i]
+    }
+}
+
+/// Fits the slice basis to `data`, projects its BRDFs and their augmentations, fits the mean
+/// and principal components of the coefficients and sets all three in `model` when `fresh`
+/// (a resumed network has them from its checkpoint; the fits are deterministic).
+pub(crate) fn prepare(
+    model: Autoencoder,
+    data: &TrainingSet,
+    layers: &SliceConfig,
+    selections: Option<&[SliceSelection]>,
+    seed: u64,
+    fresh: bool,
+    progress: &dyn Progress,
+) -> crate::error::Result<(Autoencoder, SliceFit)> {
+    progress.status(&format!("fitting a slice basis of {} directions", layers.directions));
+    let layouts: Vec<&[f32]> = (0..data.len()).map(|i| data.input(i)).collect();
+    let device = model.devices().into_iter().next().unwrap_or_default().without_autodiff();
+    let basis = fit_slice_basis(&layouts, layers.directions, seed, &device)?;
+    drop(layouts);
+    let bt = basis_t(&basis, &device);
+    let augmentation = &layers.augmentation;
+    let n = data.len();
+    let samples = augmentation.samples(n);
+    let (mut targets, mut residuals, mut valid) =
+        (Vec::with_capacity(samples), Vec::with_capacity(samples), Vec::with_capacity(samples));
+    progress.start(samples as u64, "projecting the training BRDFs and their augmentations");
+    for i in 0..samples {
+        let (layout, count) = sample_layout(data, augmentation.sample(n, i, seed))?;
+        let (a, r) = project(&layout, &bt)?;
+        targets.push(a);
+        residuals.push(r);
+        valid.push(count);
+        progress.advance(1);
+    }
+    progress.finish();
+    progress.status(&format!("fitting {} principal components", layers.components));
+    let components = fit_components(&targets, layers.components)?;
+    let mut model = model;
+    if fresh {
+        model = model.with_slice_fit(&basis, &components.mean, &components.rows)?;
+    }
+    let filled = match selections {
+        Some(selections) => {
+            progress.status("projecting the slice-dropout inputs");
+            let mut row = vec![0f32; INPUT_VALUES];
+            let filled = (0..n)
+                .map(|i| {
+                    selections
+                        .iter()
+                        .enumerate()
+                        .map(|(s, selection)| {
+                            let input = filled_input(data, i, s, selection, seed);
+                            centre(&mut row, &input, data.mask(i), None);
+                            Ok(project(&row, &bt)?.0)
+                        })
+                        .collect::<crate::error::Result<Vec<_>>>()
+                })
+                .collect::<crate::error::Result<Vec<_>>>()?;
+            Some(filled)
+        }
+        None => None,
+    };
+    Ok((model, SliceFit { targets, residuals, valid, filled }))
+}
+
+/// The eq. (4) loss of the samples `indices` (their coefficients' squared error plus their
+/// residuals, over their valid values) and its gradients; `inputs` are the encoder's input
+/// coefficients, the targets' or those of filled inputs.
+pub(crate) fn slice_gradients(
+    model: &Autoencoder,
+    fit: &SliceFit,
+    indices: &[usize],
+    inputs: Vec<f32>,
+    device: &Device,
+) -> crate::error::Result<(f32, MultiGradientsParams)> {
+    let net = model
+        .slice()
+        .ok_or_else(|| ModelError::Invalid("slice training needs a slice network".into()))?;
+    let len = net.coefficient_len();
+    let valid: f64 = indices.iter().map(|&i| fit.valid[i]).sum();
+    let residual: f64 = indices.iter().map(|&i| fit.residuals[i]).sum();
+    let targets: Vec<f32> = indices.iter().flat_map(|&i| fit.targets[i].clone()).collect();
+    let b = indices.len();
+    let target = Tensor::<2>::from_data(TensorData::new(targets, [b, len]), device);
+    let input = Tensor::<2>::from_data(TensorData::new(inputs, [b, len]), device);
+    let diff = net.decode_coefficients(net.encode_coefficients(input)) - target; // [batch, 540 M]
+    let loss = (diff.clone() * diff).sum().div_scalar(valid.max(1.0)); // [1]
+    let value: f32 = loss.clone().into_scalar();
+    let value = value + (residual / valid.max(1.0)) as f32;
+    Ok((value, on_device(GradientsParams::from_grads(loss.backward(), model), device)))
+}
