@@ -144,14 +144,22 @@ pub fn basis_t(basis: &[f32], device: &Device) -> Tensor<2> {
     Tensor::<2>::from_data(TensorData::new(basis.to_vec(), [m, SLICE_VALUES]), device).transpose()
 }
 
-/// The coefficients of `layout` in the basis (`basis_t` from [`basis_t`]): 540 x m values,
-/// row-major (image-major, as the layout), and the squared distance of the layout to the span.
-pub fn project(layout: &[f32], basis_t: &Tensor<2>) -> Result<(Vec<f32>, f64)> {
-    let x = images(&[layout], &basis_t.device());
-    let out = read(x.matmul(basis_t.clone()))?; // [540, m]
-    let total: f64 = layout.iter().map(|&v| f64::from(v) * f64::from(v)).sum();
-    let inside: f64 = out.iter().map(|&v| f64::from(v) * f64::from(v)).sum();
-    Ok((out, (total - inside).max(0.0)))
+/// The coefficients of each of `layouts` in the basis (`basis_t` from [`basis_t`]): 540 x m
+/// values, row-major (image-major, as the layout), and the squared distance of the layout to
+/// the span; one product for all of them.
+pub fn project(layouts: &[&[f32]], basis_t: &Tensor<2>) -> Result<Vec<(Vec<f32>, f64)>> {
+    let x = images(layouts, &basis_t.device());
+    let out = read(x.matmul(basis_t.clone()))?; // [540 n, m]
+    let len = out.len() / layouts.len().max(1);
+    Ok(layouts
+        .iter()
+        .zip(out.chunks(len.max(1)))
+        .map(|(layout, a)| {
+            let total: f64 = layout.iter().map(|&v| f64::from(v) * f64::from(v)).sum();
+            let inside: f64 = a.iter().map(|&v| f64::from(v) * f64::from(v)).sum();
+            (a.to_vec(), (total - inside).max(0.0))
+        })
+        .collect())
 }
 
 /// The linear path of the network: the mean of the coefficient vectors and their `k` leading
@@ -254,10 +262,12 @@ mod tests {
             }
         }
         let bt = basis_t(&basis, &device);
-        for layout in &data {
-            let (_, residual) = project(layout, &bt).unwrap();
+        let projected = project(&refs, &bt).unwrap();
+        assert_eq!(projected.len(), 3);
+        for (layout, (a, residual)) in data.iter().zip(&projected) {
+            assert_eq!(a.len(), 540 * 3);
             let total: f64 = layout.iter().map(|&v| f64::from(v * v)).sum();
-            assert!(residual < 1e-6 * total, "{residual} of {total}");
+            assert!(*residual < 1e-6 * total, "{residual} of {total}");
         }
         assert!(fit_slice_basis(&[], 3, 0, &device).is_err());
     }

@@ -24,6 +24,9 @@ use crate::slice_basis::{basis_t, fit_components, fit_slice_basis, project};
 use crate::train::run::on_device;
 use crate::training_set::TrainingSet;
 
+/// Samples projected with one product.
+const PROJECTED_AT_ONCE: usize = 8;
+
 /// The coefficients of every training sample (the BRDFs, then their augmentations).
 pub(crate) struct SliceFit {
     /// `[sample][540 * M]`: the targets.
@@ -68,13 +71,19 @@ pub(crate) fn prepare(
     let (mut targets, mut residuals, mut valid) =
         (Vec::with_capacity(samples), Vec::with_capacity(samples), Vec::with_capacity(samples));
     progress.start(samples as u64, "projecting the training BRDFs and their augmentations");
-    for i in 0..samples {
-        let (layout, count) = sample_layout(data, augmentation.sample(n, i, seed))?;
-        let (a, r) = project(&layout, &bt)?;
-        targets.push(a);
-        residuals.push(r);
-        valid.push(count);
-        progress.advance(1);
+    let indices: Vec<usize> = (0..samples).collect();
+    for group in indices.chunks(PROJECTED_AT_ONCE) {
+        let made = group
+            .iter()
+            .map(|&i| sample_layout(data, augmentation.sample(n, i, seed)))
+            .collect::<crate::error::Result<Vec<_>>>()?;
+        let layouts: Vec<&[f32]> = made.iter().map(|(l, _)| l.as_slice()).collect();
+        for ((a, r), (_, count)) in project(&layouts, &bt)?.into_iter().zip(&made) {
+            targets.push(a);
+            residuals.push(r);
+            valid.push(*count);
+        }
+        progress.advance(group.len() as u64);
     }
     progress.finish();
     progress.status(&format!("fitting {} principal components", layers.components));
@@ -95,7 +104,7 @@ pub(crate) fn prepare(
                         .map(|(s, selection)| {
                             let input = filled_input(data, i, s, selection, seed);
                             centre(&mut row, &input, data.mask(i), None);
-                            Ok(project(&row, &bt)?.0)
+                            Ok(project(&[&row], &bt)?.remove(0).0)
                         })
                         .collect::<crate::error::Result<Vec<_>>>()
                 })
