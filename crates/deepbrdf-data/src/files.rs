@@ -66,9 +66,11 @@ pub fn write_atomic_parts(path: &Path, parts: &[&[u8]]) -> Result<()> {
     if path.is_dir() {
         return Err(DataError::format(path, "is a directory; refusing to replace it by a file"));
     }
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".deepbrdf-")
-        .suffix(".tmp")
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".deepbrdf-").suffix(".tmp");
+    #[cfg(unix)]
+    builder.permissions(mode_for(path));
+    let mut tmp = builder
         .tempfile_in(dir)
         .map_err(|e| DataError::io(dir, e))?;
     for part in parts {
@@ -78,6 +80,17 @@ pub fn write_atomic_parts(path: &Path, parts: &[&[u8]]) -> Result<()> {
     tmp.persist(path).map_err(|e| DataError::io(path, e.error))?;
     sync_dir_of(path);
     Ok(())
+}
+
+/// The permissions of the file written at `path`: those of the file it replaces, else
+/// read-write for the owner and readable by all, less the umask (the temporary file's own
+/// default, owner-only, would make every output private).
+#[cfg(unix)]
+fn mode_for(path: &Path) -> std::fs::Permissions {
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::metadata(path)
+        .map(|m| m.permissions())
+        .unwrap_or_else(|_| std::fs::Permissions::from_mode(0o644))
 }
 
 /// Flushes the directory entry of `path` to disk after a rename (best effort: not every platform
@@ -96,6 +109,23 @@ mod tests {
     use super::*;
 
     type TestResult = std::result::Result<(), Box<dyn std::error::Error>>;
+
+    #[cfg(unix)]
+    #[test]
+    fn a_new_file_is_readable_by_others_and_a_replaced_one_keeps_its_mode() -> TestResult {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir()?;
+        let path = dir.path().join("out.bin");
+        write_atomic(&path, b"one")?;
+        let mode = std::fs::metadata(&path)?.permissions().mode() & 0o777;
+        assert_eq!(mode & 0o600, 0o600, "{mode:o}");
+        assert_ne!(mode, 0o600, "owner-only, as the temporary file was: {mode:o}");
+        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o640))?;
+        write_atomic(&path, b"two")?;
+        assert_eq!(std::fs::metadata(&path)?.permissions().mode() & 0o777, 0o640);
+        assert_eq!(std::fs::read(&path)?, b"two");
+        Ok(())
+    }
 
     #[test]
     fn atomic_write_replaces_and_leaves_no_temporary() -> TestResult {
