@@ -32,26 +32,58 @@ fn train_a_regressor_edit_and_interpolate() {
         runs.push(run);
     }
     let (model, other) = (s(&runs[0]), s(&runs[1]));
-    let printed = ok(&["train-regressor", "--model", &model, "--data", &s(&data), "--epochs", "30", "--ipca"]);
+    let printed = ok(&[
+        "train-regressor",
+        "--model",
+        &model,
+        "--data",
+        &s(&data),
+        "--epochs",
+        "30",
+        "--ipca",
+    ]);
     assert!(printed.contains("training relative error"), "{printed}");
     let regressor = runs[0].join("regressor");
-    assert!(regressor.join("deepbrdf.regressor").is_file() && regressor.join("ipca.regressor").is_file());
+    assert!(
+        regressor.join("deepbrdf.regressor").is_file()
+            && regressor.join("ipca.regressor").is_file()
+    );
     // Not replaced without --force.
-    let out = util::run_in(dir.path(), &["train-regressor", "--model", &model, "--data", &s(&data), "--epochs", "3"]);
+    let out = util::run_in(
+        dir.path(),
+        &["train-regressor", "--model", &model, "--data", &s(&data), "--epochs", "3"],
+    );
     util::assert_clean_failure(&out, "--force");
 
     let m1 = s(&data.join("m1.binary"));
     for mode in ["paper", "residual"] {
         let edited = dir.path().join(format!("edited-{mode}.binary"));
         let printed = ok(&[
-            "edit", "--model", &model, &m1, "--diffuse-scale", "0.5", "--mode", mode, "-o", &s(&edited),
-            "--render", &s(&dir.path().join(format!("{mode}.png"))), "--size", "16", "--spp", "1",
+            "edit",
+            "--model",
+            &model,
+            &m1,
+            "--diffuse-scale",
+            "0.5",
+            "--mode",
+            mode,
+            "-o",
+            &s(&edited),
+            "--render",
+            &s(&dir.path().join(format!("{mode}.png"))),
+            "--size",
+            "16",
+            "--spp",
+            "1",
         ]);
         assert!(printed.contains("requested") && printed.contains("achieved"), "{printed}");
         assert_eq!(read_merl(&edited).unwrap().mask(), util::material(1).mask());
     }
     let edited = s(&dir.path().join("edited-paper.binary"));
-    let out = util::run_in(dir.path(), &["edit", "--model", &model, &m1, "--roughness-scale", "2", "-o", &edited]);
+    let out = util::run_in(
+        dir.path(),
+        &["edit", "--model", &model, &m1, "--roughness-scale", "2", "-o", &edited],
+    );
     util::assert_clean_failure(&out, "--force");
     let bad = |args: &[&str], needle: &str| {
         let mut all = vec!["edit", "--model", &model, &m1];
@@ -68,7 +100,18 @@ fn train_a_regressor_edit_and_interpolate() {
     // The regressor of model 0 with model 1: refused, naming both.
     let out = util::run_in(
         dir.path(),
-        &["edit", "--model", &other, "--regressor", &s(&regressor), &m1, "--diffuse-scale", "0.5", "-o", "x.binary"],
+        &[
+            "edit",
+            "--model",
+            &other,
+            "--regressor",
+            &s(&regressor),
+            &m1,
+            "--diffuse-scale",
+            "0.5",
+            "-o",
+            "x.binary",
+        ],
     );
     util::assert_clean_failure(&out, "belongs to DeepBRDF model");
     let out = util::run_in(dir.path(), &["edit", "--model", &other, &m1, "-o", "x.binary"]);
@@ -76,7 +119,15 @@ fn train_a_regressor_edit_and_interpolate() {
 
     let strip = dir.path().join("interp");
     let printed = ok(&[
-        "interpolate", "--model", &model, &s(&data.join("m0.binary")), &m1, "--steps", "3", "--out", &s(&strip),
+        "interpolate",
+        "--model",
+        &model,
+        &s(&data.join("m0.binary")),
+        &m1,
+        "--steps",
+        "3",
+        "--out",
+        &s(&strip),
     ]);
     assert!(printed.contains("linear blend") && printed.contains("IPCA"), "{printed}");
     assert!(strip.join("strip.png").is_file() && strip.join("deepbrdf-02.binary").is_file());

@@ -10,7 +10,7 @@ mod editing;
 mod fetch_merl;
 mod kill;
 mod model;
-mod reliability;
 mod recovery;
+mod reliability;
 mod render;
 mod sweep_k;

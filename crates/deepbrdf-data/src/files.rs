@@ -70,9 +70,7 @@ pub fn write_atomic_parts(path: &Path, parts: &[&[u8]]) -> Result<()> {
     builder.prefix(".deepbrdf-").suffix(".tmp");
     #[cfg(unix)]
     builder.permissions(mode_for(path));
-    let mut tmp = builder
-        .tempfile_in(dir)
-        .map_err(|e| DataError::io(dir, e))?;
+    let mut tmp = builder.tempfile_in(dir).map_err(|e| DataError::io(dir, e))?;
     for part in parts {
         tmp.write_all(part).map_err(|e| DataError::io(tmp.path(), e))?;
     }

@@ -428,8 +428,9 @@ pub(crate) fn load_weights<M: Module>(network: M, weights: Vec<u8>) -> Result<M>
     let bad = |e: burn::store::RecordError| {
         ModelError::Invalid(format!("the weights do not fit the configuration: {e}"))
     };
-    let record = crate::record::float_record(weights)
-        .map_err(|e| ModelError::Invalid(format!("the weights do not fit the configuration: {e}")))?;
+    let record = crate::record::float_record(weights).map_err(|e| {
+        ModelError::Invalid(format!("the weights do not fit the configuration: {e}"))
+    })?;
     network.try_load_record(record).map_err(bad)
 }
 

@@ -115,7 +115,9 @@ pub fn sample_layout(data: &TrainingSet, sample: Sample) -> crate::error::Result
     })?;
     let mut out = vec![0f32; INPUT_VALUES];
     let unmap = |x: f32, r: f32| inverse_log_relative(f64::from(x), f64::from(r));
-    let map = |rho: f64, r: f32| log_relative(rho.max(-deepbrdf_data::mapping::EPSILON), f64::from(r)) as f32;
+    let map = |rho: f64, r: f32| {
+        log_relative(rho.max(-deepbrdf_data::mapping::EPSILON), f64::from(r)) as f32
+    };
     let valid = match sample {
         Sample::Original(_) => unreachable!("returned above"),
         Sample::Permuted { index, order } => {
@@ -189,10 +191,12 @@ mod tests {
     fn permutations_and_mixtures_are_computed_in_linear_space() {
         let data = set();
         let reference = data.reference_layout().unwrap().to_vec();
-        let linear = |x: &[f32], i: usize| inverse_log_relative(f64::from(x[i]), f64::from(reference[i]));
+        let linear =
+            |x: &[f32], i: usize| inverse_log_relative(f64::from(x[i]), f64::from(reference[i]));
         // Slice 7, a valid cell of image (7, colour): red and blue swapped (order [2, 1, 0]).
         let cell = (0..IMAGE).find(|&c| data.mask(0)[(7 * 3) * IMAGE + c] != 0.0).unwrap();
-        let (swapped, valid) = sample_layout(&data, Sample::Permuted { index: 0, order: 5 }).unwrap();
+        let (swapped, valid) =
+            sample_layout(&data, Sample::Permuted { index: 0, order: 5 }).unwrap();
         assert_eq!(valid, data.valid_values(0));
         let red = 7 * 3 * IMAGE + cell;
         let blue = (7 * 3 + 2) * IMAGE + cell;
@@ -204,8 +208,13 @@ mod tests {
         // Invalid cells stay 0.
         let invalid = (0..INPUT_VALUES).find(|&i| data.mask(0)[i] == 0.0).unwrap();
         assert_eq!(mixed[invalid], 0.0);
-        let no_reference =
-            TrainingSet::from_layouts("x", vec!["a".into()], vec![data.input(0).to_vec()], vec![data.mask(0).to_vec()]).unwrap();
+        let no_reference = TrainingSet::from_layouts(
+            "x",
+            vec!["a".into()],
+            vec![data.input(0).to_vec()],
+            vec![data.mask(0).to_vec()],
+        )
+        .unwrap();
         assert!(sample_layout(&no_reference, Sample::Permuted { index: 0, order: 1 }).is_err());
     }
 }

@@ -11,8 +11,8 @@
 //! - [`fit`]: all of the above on a set of MERL tables.
 //! - [`recovery`]: single-image recovery (§5.2): the CNN from a photo to the latent, Fig. 15.
 pub mod artifact;
-pub mod augmentation;
 mod atomic;
+pub mod augmentation;
 pub mod autoencoder;
 pub mod codec;
 pub mod compact;
@@ -23,9 +23,9 @@ pub mod fit;
 pub mod loss;
 pub mod preset;
 pub mod principal;
-pub mod regressor;
 mod record;
 pub mod recovery;
+pub mod regressor;
 pub mod seeded;
 pub mod slice_basis;
 pub mod spectral;

@@ -130,7 +130,8 @@ pub fn fit_slice_basis(
     let mut rows = vec![0f32; m * SLICE_VALUES];
     for (j, &e) in order.iter().take(m).enumerate() {
         let direction = &q * eig.eigenvectors.column(e);
-        for (r, v) in rows[j * SLICE_VALUES..(j + 1) * SLICE_VALUES].iter_mut().zip(direction.iter())
+        for (r, v) in
+            rows[j * SLICE_VALUES..(j + 1) * SLICE_VALUES].iter_mut().zip(direction.iter())
         {
             *r = *v as f32;
         }
@@ -254,7 +255,8 @@ mod tests {
         let basis = fit_slice_basis(&refs, 3, 7, &device).unwrap();
         assert_eq!(basis, fit_slice_basis(&refs, 3, 7, &device).unwrap(), "deterministic");
         let row = |j: usize| &basis[j * SLICE_VALUES..(j + 1) * SLICE_VALUES];
-        let dot = |x: &[f32], y: &[f32]| x.iter().zip(y).map(|(a, b)| f64::from(a * b)).sum::<f64>();
+        let dot =
+            |x: &[f32], y: &[f32]| x.iter().zip(y).map(|(a, b)| f64::from(a * b)).sum::<f64>();
         for i in 0..3 {
             for j in 0..3 {
                 let want = if i == j { 1.0 } else { 0.0 };

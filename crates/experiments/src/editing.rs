@@ -131,8 +131,14 @@ pub fn quick_fit() -> FitConfig {
 }
 
 /// The attributes of `table` (the library's fit).
-pub fn attributes_of(table: &MerlTable, name: &str, config: &FitConfig) -> anyhow::Result<Attributes> {
-    Ok(attributes::fit(table, config).with_context(|| format!("fitting the attributes of {name}"))?.attributes)
+pub fn attributes_of(
+    table: &MerlTable,
+    name: &str,
+    config: &FitConfig,
+) -> anyhow::Result<Attributes> {
+    Ok(attributes::fit(table, config)
+        .with_context(|| format!("fitting the attributes of {name}"))?
+        .attributes)
 }
 
 /// The regressor directory of a model directory: `--regressor DIR` if given, else

@@ -82,7 +82,9 @@ impl Edit {
     pub fn apply(&self, a: &Attributes) -> Result<Attributes> {
         let roughness = match self.roughness {
             None => a.roughness,
-            Some(ScalarEdit::Set(r)) | Some(ScalarEdit::Scale(r)) if !(r.is_finite() && r > 0.0) => {
+            Some(ScalarEdit::Set(r)) | Some(ScalarEdit::Scale(r))
+                if !(r.is_finite() && r > 0.0) =>
+            {
                 return Err(EvalError::Invalid(format!(
                     "roughness {r} must be a positive number (a GGX alpha in \
                      [{MIN_ROUGHNESS}, {MAX_ROUGHNESS}], or a scale > 0)"
@@ -124,7 +126,10 @@ mod tests {
         assert!((e.apply(&a).unwrap().roughness - 0.2).abs() < 1e-12);
         let cases = [
             (Edit { diffuse: Some(ColourEdit::Scale(3.0)), ..Edit::default() }, "diffuse albedo R"),
-            (Edit { specular: Some(ColourEdit::Set([0.1, 1.5, 0.1])), ..Edit::default() }, "specular albedo G"),
+            (
+                Edit { specular: Some(ColourEdit::Set([0.1, 1.5, 0.1])), ..Edit::default() },
+                "specular albedo G",
+            ),
             (Edit { diffuse: Some(ColourEdit::Scale(-1.0)), ..Edit::default() }, ">= 0"),
             (Edit { roughness: Some(ScalarEdit::Set(-0.2)), ..Edit::default() }, "positive"),
             (Edit { roughness: Some(ScalarEdit::Scale(20.0)), ..Edit::default() }, "outside"),

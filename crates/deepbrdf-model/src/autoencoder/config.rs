@@ -12,8 +12,8 @@ use super::convolutional::Convolutional;
 use super::legacy;
 use super::slice_network::SliceNetwork;
 use super::spectral_network::SpectralNetwork;
-use crate::augmentation::AugmentationConfig;
 use super::Autoencoder;
+use crate::augmentation::AugmentationConfig;
 use crate::error::ModelError;
 
 /// K of the `cpu` preset's spectral path: 96 principal directions of the training set (100

@@ -59,7 +59,8 @@ impl SliceNetwork {
     /// [`with_fit`](Self::with_fit), the MLPs' last layers at zero.
     pub(super) fn new(config: &AutoencoderConfig, layers: &SliceConfig, device: &Device) -> Self {
         let (hidden_init, _) = config.initializers(true);
-        let mlp = |from: usize, to: usize| mlp_layers(from, layers.hidden, to, &hidden_init, device);
+        let mlp =
+            |from: usize, to: usize| mlp_layers(from, layers.hidden, to, &hidden_init, device);
         let (m, size, k) = (layers.directions, layers.components, config.latent);
         Self {
             basis: fixed([m, SLICE_VALUES], device),
@@ -106,7 +107,9 @@ impl SliceNetwork {
         ];
         for (what, got, want) in sizes {
             if got != want {
-                return Err(ModelError::Invalid(format!("{what}: {want} values expected, got {got}")));
+                return Err(ModelError::Invalid(format!(
+                    "{what}: {want} values expected, got {got}"
+                )));
             }
         }
         if let Some(i) = basis.iter().chain(mean).chain(components).position(|v| !v.is_finite()) {
@@ -183,7 +186,8 @@ impl SliceNetwork {
         let device = latent.device();
         let z = latent.unsqueeze_dim::<3>(1).repeat_dim(1, N_PHI_D); // [batch, 180, k]
         let features = self.slice_features(&device).unsqueeze_dim::<3>(0).repeat_dim(0, batch); // [batch, 180, 2H]
-        let input = Tensor::cat(vec![z, features], 2).reshape([batch * N_PHI_D, k + 2 * self.harmonics]);
+        let input =
+            Tensor::cat(vec![z, features], 2).reshape([batch * N_PHI_D, k + 2 * self.harmonics]);
         let g = self.mlp(&self.decoder, input).map(|g| g.reshape([batch, len])); // [batch, 540 M]
         match g {
             Some(g) => linear + g,

@@ -234,8 +234,8 @@ impl Regressor {
         manifest.scaling.validate(manifest.target.k).map_err(|e| bad(e.to_string()))?;
         let device = device.clone().without_autodiff();
         let skeleton = crate::seeded::exclusive(|| RegressorNet::init(&shape, &device));
-        let record =
-            crate::record::float_record(weights.clone()).map_err(|e| bad(format!("bad weights: {e}")))?;
+        let record = crate::record::float_record(weights.clone())
+            .map_err(|e| bad(format!("bad weights: {e}")))?;
         let net = skeleton
             .try_load_record(record)
             .map_err(|e| bad(format!("the weights do not fit the network: {e}")))?;

@@ -34,7 +34,8 @@ fn pairs(n: usize) -> RegressorData {
 
 fn config(epochs: usize) -> RegressorConfig {
     let mut c = RegressorConfig { hidden: 32, ..RegressorConfig::default() };
-    c.training = c.training.with_epochs(epochs).with_learning_rate(3e-3).with_checkpoint_seconds(0.0);
+    c.training =
+        c.training.with_epochs(epochs).with_learning_rate(3e-3).with_checkpoint_seconds(0.0);
     c
 }
 
@@ -60,7 +61,8 @@ fn a_regressor_learns_saves_and_refuses_another_model() {
 
     let path = dir.path().join(TargetKind::DeepBrdf.file_name());
     r.save(&path).unwrap();
-    let back = Regressor::load_for(dir.path(), TargetKind::DeepBrdf, "model-a", 3, &device()).unwrap();
+    let back =
+        Regressor::load_for(dir.path(), TargetKind::DeepBrdf, "model-a", 3, &device()).unwrap();
     assert_eq!(back.id(), r.id());
     assert_eq!(back.predict(&data.attributes[3]).unwrap(), r.predict(&data.attributes[3]).unwrap());
 
@@ -96,7 +98,8 @@ fn a_regressor_learns_saves_and_refuses_another_model() {
     // the training seconds).
     let other = tempfile::tempdir().unwrap();
     let session = Session::new(other.path(), false, &Silent, "regressor");
-    let again = train_regressor(&data, &config(60), target("model-a"), &session, &device()).unwrap();
+    let again =
+        train_regressor(&data, &config(60), target("model-a"), &session, &device()).unwrap();
     for a in &data.attributes {
         assert_eq!(again.predict(a).unwrap(), r.predict(a).unwrap());
     }

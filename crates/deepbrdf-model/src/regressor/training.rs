@@ -164,12 +164,17 @@ pub fn train_regressor(
         )));
     }
     if config.hidden == 0 || !config.negative_slope.is_finite() {
-        return Err(ModelError::Invalid("the regressor needs hidden units and a finite slope".into()));
+        return Err(ModelError::Invalid(
+            "the regressor needs hidden units and a finite slope".into(),
+        ));
     }
     let feats = data.attributes.iter().map(features).collect::<Result<Vec<_>>>()?;
     let scaling = Scaling::fit(&feats, &data.targets)?;
-    let shape =
-        NetworkShape { hidden: config.hidden, outputs: target.k, negative_slope: config.negative_slope };
+    let shape = NetworkShape {
+        hidden: config.hidden,
+        outputs: target.k,
+        negative_slope: config.negative_slope,
+    };
     let mut step = Step {
         inputs: feats.iter().map(|f| scaling.standardise(f)).collect(),
         targets: data.targets.clone(),
@@ -195,7 +200,8 @@ pub fn train_regressor(
         train_relative_error: 0.0,
         train_seconds: outcome.seconds,
     };
-    let mut regressor = Regressor::new(target, shape, scaling, provenance, outcome.model.valid(), device)?;
+    let mut regressor =
+        Regressor::new(target, shape, scaling, provenance, outcome.model.valid(), device)?;
     let errors: Vec<f64> = data
         .attributes
         .iter()

@@ -50,13 +50,23 @@ pub struct Args {
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct EditArgs {
     /// Set the diffuse albedo (each in [0, 1]).
-    #[arg(long, value_name = "R,G,B", conflicts_with = "diffuse_scale", allow_hyphen_values = true)]
+    #[arg(
+        long,
+        value_name = "R,G,B",
+        conflicts_with = "diffuse_scale",
+        allow_hyphen_values = true
+    )]
     pub diffuse: Option<String>,
     /// Multiply the diffuse albedo.
     #[arg(long, value_name = "X", allow_hyphen_values = true)]
     pub diffuse_scale: Option<f64>,
     /// Set the specular albedo (each in [0, 1]).
-    #[arg(long, value_name = "R,G,B", conflicts_with = "specular_scale", allow_hyphen_values = true)]
+    #[arg(
+        long,
+        value_name = "R,G,B",
+        conflicts_with = "specular_scale",
+        allow_hyphen_values = true
+    )]
     pub specular: Option<String>,
     /// Multiply the specular albedo.
     #[arg(long, value_name = "X", allow_hyphen_values = true)]

@@ -65,7 +65,10 @@ fn suite_edits(a: &Attributes) -> Vec<(&'static str, Edit)> {
     vec![
         ("identity", Edit::default()),
         ("diffuse x0.5", Edit { diffuse: Some(ColourEdit::Scale(0.5)), ..Edit::default() }),
-        ("diffuse hue", Edit { diffuse: Some(ColourEdit::Set([d[2], d[0], d[1]])), ..Edit::default() }),
+        (
+            "diffuse hue",
+            Edit { diffuse: Some(ColourEdit::Set([d[2], d[0], d[1]])), ..Edit::default() },
+        ),
         ("specular x0.5", Edit { specular: Some(ColourEdit::Scale(0.5)), ..Edit::default() }),
         ("roughness x0.5", Edit { roughness: Some(ScalarEdit::Scale(0.5)), ..Edit::default() }),
         ("roughness x2", Edit { roughness: Some(ScalarEdit::Scale(2.0)), ..Edit::default() }),
@@ -122,7 +125,8 @@ fn sweep(
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let started = Instant::now();
     let model_dir = args.model.dir()?;
-    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
     let device = crate::device_arg::device()?;
     let (model, deep_regressor) =
         editing::load_editor(&model_dir, args.regressor.as_deref(), &device)?;
@@ -153,7 +157,11 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let ipca_regressor = match Regressor::load_for(&reg_dir, TargetKind::Ipca, &owner, k, &device) {
         Ok(r) => r,
         Err(_) => {
-            let targets = set.tables.iter().map(|t| ipca.encode(t)).collect::<deepbrdf_eval::Result<Vec<_>>>()?;
+            let targets = set
+                .tables
+                .iter()
+                .map(|t| ipca.encode(t))
+                .collect::<deepbrdf_eval::Result<Vec<_>>>()?;
             let data = RegressorData {
                 label: set.label.clone(),
                 names: set.names.clone(),
@@ -167,11 +175,15 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         }
     };
     let deep_codec = ModelCodec(&model);
-    let deep = Rep { name: "DeepBRDF", space: Space { codec: &deep_codec, regressor: &deep_regressor } };
+    let deep =
+        Rep { name: "DeepBRDF", space: Space { codec: &deep_codec, regressor: &deep_regressor } };
     let ipca_rep = Rep { name: "IPCA", space: Space { codec: &ipca, regressor: &ipca_regressor } };
     let reps = [&deep, &ipca_rep];
     let index = |name: &str| {
-        set.names.iter().position(|n| n == name).with_context(|| format!("{name} is not in {}", set.label))
+        set.names
+            .iter()
+            .position(|n| n == name)
+            .with_context(|| format!("{name} is not in {}", set.label))
     };
     let mut md = format!(
         "# Editing (§5.1): figures and measured suite\n\nWritten by `experiments figures-editing` (model {}, k = {k}, {} materials of {}; in-sample: the autoencoder and both regressors were trained on every material).\n\n",
@@ -184,10 +196,13 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     if !args.no_figures {
         // Fig. 10.
         let (a, b) = (index("red-metallic-paint")?, index("red-fabric")?);
-        let paths = interpolate::paths(&model, Some(&ipca), &set.tables[a], &set.tables[b], 9, progress)?;
+        let paths =
+            interpolate::paths(&model, Some(&ipca), &set.tables[a], &set.tables[b], 9, progress)?;
         let refs: Vec<&Path3> = paths.iter().collect();
-        interpolate::strip(&refs, &|row, i| format!("{} t={:.3}", paths[row].name, i as f64 / 8.0))?
-            .write_png(&args.out.join("fig10_interpolation.png"))?;
+        interpolate::strip(&refs, &|row, i| {
+            format!("{} t={:.3}", paths[row].name, i as f64 / 8.0)
+        })?
+        .write_png(&args.out.join("fig10_interpolation.png"))?;
         md += "## Fig. 10: red-metallic-paint to red-fabric, 9 steps\n\n![Fig. 10](fig10_interpolation.png)\n\nImage RelAE between consecutive steps (128 px sphere, sun and sky, 16 spp):\n\n";
         md += &interpolate::summary(&paths)?;
 
@@ -225,10 +240,17 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                 .iter()
                 .map(|r| {
                     let a = editing::attributes_of(&r.tables[i + 1], name, &fit)?;
-                    anyhow::Ok(format!("{:.3} {:.3} {:.3}", a.diffuse[0], a.diffuse[1], a.diffuse[2]))
+                    anyhow::Ok(format!(
+                        "{:.3} {:.3} {:.3}",
+                        a.diffuse[0], a.diffuse[1], a.diffuse[2]
+                    ))
                 })
                 .collect::<anyhow::Result<_>>()?;
-            let _ = writeln!(md, "| {name} | {:.3} {:.3} {:.3} | {} | {} |", c[0], c[1], c[2], got[0], got[1]);
+            let _ = writeln!(
+                md,
+                "| {name} | {:.3} {:.3} {:.3} | {} | {} |",
+                c[0], c[1], c[2], got[0], got[1]
+            );
         }
 
         // Figs. 13 and 14: roughness sweeps.
@@ -259,7 +281,8 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                         .iter()
                         .map(|t| Ok(editing::attributes_of(t, material, &fit)?.roughness))
                         .collect::<anyhow::Result<_>>()?;
-                    let requested: Vec<String> = usable.iter().map(|(s, _)| format!("{:.3}", a.roughness * s)).collect();
+                    let requested: Vec<String> =
+                        usable.iter().map(|(s, _)| format!("{:.3}", a.roughness * s)).collect();
                     let shown: Vec<String> = got.iter().map(|r| format!("{r:.3}")).collect();
                     let _ = writeln!(
                         sweeps_md,
@@ -271,7 +294,11 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                         if is_monotone(&got, true, 0.0) { "yes" } else { "no" }
                     );
                     let images = interpolate::render_all(&reference, &tables)?;
-                    rows.push(Path3 { name: format!("{} {}", rep.name, mode.name()), tables, images });
+                    rows.push(Path3 {
+                        name: format!("{} {}", rep.name, mode.name()),
+                        tables,
+                        images,
+                    });
                 }
             }
             let refs: Vec<&Path3> = rows.iter().collect();
@@ -303,7 +330,8 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                         continue; // an edit out of range for this material (e.g. x2 past alpha 1)
                     };
                     let achieved = editing::attributes_of(&edited.table, name, &quick)?;
-                    let outcome = edit_outcome(original, &edited.requested, &achieved, edit.edited());
+                    let outcome =
+                        edit_outcome(original, &edited.requested, &achieved, edit.edited());
                     let identity_relae = match edit_name {
                         "identity" => reference.measure(&edited.table)?,
                         _ => f64::NAN,
@@ -331,8 +359,18 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         let _ = writeln!(
             csv,
             "{},{},{},{},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{},{:.6}",
-            r.material, r.method, r.mode.name(), r.edit, o.target_error, o.change_ratio,
-            o.diffuse_drift, o.specular_drift, o.roughness_drift, r.identity_relae, r.plausible, r.max_albedo
+            r.material,
+            r.method,
+            r.mode.name(),
+            r.edit,
+            o.target_error,
+            o.change_ratio,
+            o.diffuse_drift,
+            o.specular_drift,
+            o.roughness_drift,
+            r.identity_relae,
+            r.plausible,
+            r.max_albedo
         );
     }
     deepbrdf_data::files::write_atomic(&args.out.join("suite.csv"), csv.as_bytes())?;

@@ -68,7 +68,8 @@ pub fn ipca_basis(
     data: &DataArgs,
     progress: &dyn Progress,
 ) -> anyhow::Result<Arc<BaselineBasis>> {
-    let shipped = model_dir.join(crate::editing::REGRESSOR_DIR).join(super::train_regressor::IPCA_BASIS_FILE);
+    let shipped =
+        model_dir.join(crate::editing::REGRESSOR_DIR).join(super::train_regressor::IPCA_BASIS_FILE);
     let path = given.map(Path::to_path_buf).or_else(|| shipped.exists().then_some(shipped));
     Ok(Arc::new(match path {
         Some(p) => BaselineBasis::load(&p).with_context(|| format!("loading {}", p.display()))?,
@@ -86,12 +87,18 @@ pub fn render_all(reference: &ImageRelae, tables: &[MerlTable]) -> anyhow::Resul
 }
 
 /// The strip: one row per path, captioned.
-pub fn strip(paths: &[&Path3], captions: &dyn Fn(usize, usize) -> String) -> anyhow::Result<deepbrdf_render::image::Srgb8Image> {
+pub fn strip(
+    paths: &[&Path3],
+    captions: &dyn Fn(usize, usize) -> String,
+) -> anyhow::Result<deepbrdf_render::image::Srgb8Image> {
     let tonemap = Tonemap { exposure: 1.0 };
     let mut tiles = Vec::new();
     for (row, p) in paths.iter().enumerate() {
         for (i, img) in p.images.iter().enumerate() {
-            tiles.push(Tile { image: img.to_srgb8(&tonemap, [24, 24, 24]), caption: captions(row, i) });
+            tiles.push(Tile {
+                image: img.to_srgb8(&tonemap, [24, 24, 24]),
+                caption: captions(row, i),
+            });
         }
     }
     let columns = paths.first().map(|p| p.images.len()).unwrap_or(1) as u32;
@@ -160,17 +167,24 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let model_dir = args.model.dir()?;
     if args.out.exists() && std::fs::read_dir(&args.out)?.next().is_some() {
         if !args.out.join("summary.md").exists() {
-            bail!("{} exists and is not an interpolate output; not writing into it", args.out.display());
+            bail!(
+                "{} exists and is not an interpolate output; not writing into it",
+                args.out.display()
+            );
         }
     }
-    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
     let cache = args.data.cache();
-    let (name_a, a) = load_material(&args.a, &cache).with_context(|| format!("loading '{}'", args.a))?;
-    let (name_b, b) = load_material(&args.b, &cache).with_context(|| format!("loading '{}'", args.b))?;
+    let (name_a, a) =
+        load_material(&args.a, &cache).with_context(|| format!("loading '{}'", args.a))?;
+    let (name_b, b) =
+        load_material(&args.b, &cache).with_context(|| format!("loading '{}'", args.b))?;
     let device = crate::device_arg::device()?;
     let model = DeepBrdf::load(&model_dir, &device)
         .with_context(|| format!("loading the model {}", model_dir.display()))?;
-    let basis = ipca_basis(&model_dir, args.ipca_basis.as_deref(), model.k(), &args.data, progress)?;
+    let basis =
+        ipca_basis(&model_dir, args.ipca_basis.as_deref(), model.k(), &args.data, progress)?;
     let ipca = basis.codec(model.k())?;
     let steps = args.steps as usize;
     let paths = paths(&model, Some(&ipca), &a, &b, steps, progress)?;
@@ -178,7 +192,11 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         if p.name != "DeepBRDF" && !args.all_tables {
             continue;
         }
-        let stem: String = p.name.chars().map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_lowercase() } else { '-' }).collect();
+        let stem: String = p
+            .name
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_lowercase() } else { '-' })
+            .collect();
         for (i, t) in p.tables.iter().enumerate() {
             write_merl(t, args.out.join(format!("{stem}-{i:02}.binary")))?;
         }

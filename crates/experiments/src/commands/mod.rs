@@ -25,8 +25,8 @@ pub mod sheet;
 pub mod sweep_k;
 pub mod tabulate;
 pub mod train;
-pub mod train_regressor;
 pub mod train_recovery;
+pub mod train_regressor;
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     let progress = Bars::new(cli.quiet);

@@ -100,15 +100,8 @@ fn train_in(
     let fingerprint = data.fingerprint();
     let mut step = AutoencoderStep::new(config, data)?;
     let samples = step.samples();
-    let outcome = run(
-        &config.loop_config(),
-        &identity,
-        &fingerprint,
-        samples,
-        &mut step,
-        session,
-        device,
-    )?;
+    let outcome =
+        run(&config.loop_config(), &identity, &fingerprint, samples, &mut step, session, device)?;
     let model = outcome.model.valid();
     let per_material_mse = evaluate(&model, data, config.batch_size, session.progress())?;
     Ok(Trained {

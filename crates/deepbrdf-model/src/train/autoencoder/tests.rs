@@ -297,8 +297,13 @@ fn slice_dropout_fills_inputs_but_keeps_targets() {
 fn valid_set() -> TrainingSet {
     let set = mixed_set();
     let inputs = (0..set.len()).map(|i| set.input(i).to_vec()).collect();
-    TrainingSet::from_layouts("valid", set.names().to_vec(), inputs, vec![vec![1.0; INPUT_VALUES]; 4])
-        .unwrap()
+    TrainingSet::from_layouts(
+        "valid",
+        set.names().to_vec(),
+        inputs,
+        vec![vec![1.0; INPUT_VALUES]; 4],
+    )
+    .unwrap()
 }
 
 fn slice_config(epochs: usize) -> TrainConfig {
