@@ -461,20 +461,28 @@ pub(crate) fn part_of(bytes: &[u8], file: &str) -> Part {
 
 /// `path` itself if it holds a manifest, else `path/model` if that does.
 pub fn resolve_dir(path: &Path) -> Result<PathBuf> {
-    if path.join(MANIFEST_FILE).is_file() {
+    resolve_artifact_dir(path, MANIFEST_FILE, MODEL_DIR, "a DeepBRDF model")
+}
+
+/// `path` itself if it holds `manifest`, else `path/inner` if that does; else an error saying
+/// that `path` is not `what` (an artifact of this crate: a model, a recovery network).
+pub(crate) fn resolve_artifact_dir(
+    path: &Path,
+    manifest: &str,
+    inner: &str,
+    what: &str,
+) -> Result<PathBuf> {
+    if path.join(manifest).is_file() {
         return Ok(path.to_path_buf());
     }
-    let inner = path.join(MODEL_DIR);
-    if inner.join(MANIFEST_FILE).is_file() {
-        return Ok(inner);
+    let inner_dir = path.join(inner);
+    if inner_dir.join(manifest).is_file() {
+        return Ok(inner_dir);
     }
     if !path.exists() {
         return Err(ModelError::io(path, std::io::Error::from(std::io::ErrorKind::NotFound)));
     }
-    Err(ModelError::format(
-        path,
-        format!("not a DeepBRDF model (no {MANIFEST_FILE} here or in {MODEL_DIR}/)"),
-    ))
+    Err(ModelError::format(path, format!("not {what} (no {manifest} here or in {inner}/)")))
 }
 
 /// Writes an artifact directory `dir` with `write_parts` into a temporary sibling and renames

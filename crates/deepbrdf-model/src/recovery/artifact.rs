@@ -287,20 +287,12 @@ impl RecoveryArtifact {
 
 /// `path` if it holds a recovery manifest, else `path/recovery` if that does.
 fn resolve(path: &Path) -> Result<PathBuf> {
-    if path.join(RECOVERY_MANIFEST).is_file() {
-        return Ok(path.to_path_buf());
-    }
-    let inner = path.join(RECOVERY_DIR);
-    if inner.join(RECOVERY_MANIFEST).is_file() {
-        return Ok(inner);
-    }
-    if !path.exists() {
-        return Err(ModelError::io(path, std::io::Error::from(std::io::ErrorKind::NotFound)));
-    }
-    Err(ModelError::format(
+    crate::artifact::resolve_artifact_dir(
         path,
-        format!("not a recovery network (no {RECOVERY_MANIFEST} here or in {RECOVERY_DIR}/)"),
-    ))
+        RECOVERY_MANIFEST,
+        RECOVERY_DIR,
+        "a recovery network",
+    )
 }
 
 /// A loaded recovery network: prepared images in, targets out.
