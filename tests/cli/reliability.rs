@@ -129,21 +129,27 @@ fn spawn(mut cmd: Command) -> std::process::Child {
     cmd.spawn().expect("spawn experiments")
 }
 
+/// Three synthetic materials in `dir` and a training configuration for them: the cpu preset's
+/// kind of network, tiny, trained `epochs` epochs with a checkpoint after every batch (so kills
+/// land in epochs, in checkpoint writes and in the final save alike). Returns (data, config).
+fn kill_test_setup(dir: &Path, epochs: usize) -> (std::path::PathBuf, std::path::PathBuf) {
+    use deepbrdf_model::burn::config::Config as _;
+    use deepbrdf_model::{AutoencoderConfig, TrainConfig};
+    let data = util::write_data(dir, 3);
+    let mut config =
+        TrainConfig::cpu(2).with_epochs(epochs).with_batch_size(1).with_checkpoint_seconds(0.0);
+    config.model = AutoencoderConfig::spectral(2, 3, Some(8));
+    let config_path = dir.join("tiny.json");
+    config.save(&config_path).expect("config");
+    (data, config_path)
+}
+
 #[test]
 fn train_killed_at_random_moments_resumes_to_bit_identical_weights() {
-    use deepbrdf_model::burn::config::Config as _;
     use deepbrdf_model::train::checkpoint_path;
-    use deepbrdf_model::{AutoencoderConfig, TrainConfig};
 
     let dir = tempfile::tempdir().expect("tempdir");
-    let data = util::write_data(dir.path(), 3);
-    // The cpu preset's kind of network, tiny; a checkpoint after every batch, so kills land in
-    // epochs, in checkpoint writes and in the final save alike.
-    let mut config =
-        TrainConfig::cpu(2).with_epochs(60).with_batch_size(1).with_checkpoint_seconds(0.0);
-    config.model = AutoencoderConfig::spectral(2, 3, Some(8));
-    let config_path = dir.path().join("tiny.json");
-    config.save(&config_path).expect("config");
+    let (data, config_path) = kill_test_setup(dir.path(), 60);
     let exe = env!("CARGO_BIN_EXE_experiments");
     // A fresh start if no checkpoint was written yet, else --resume.
     let start = |out: &Path| {
@@ -172,16 +178,8 @@ fn train_killed_at_random_moments_resumes_to_bit_identical_weights() {
 
 #[test]
 fn sweep_k_killed_at_random_moments_continues_to_identical_results() {
-    use deepbrdf_model::burn::config::Config as _;
-    use deepbrdf_model::{AutoencoderConfig, TrainConfig};
-
     let dir = tempfile::tempdir().expect("tempdir");
-    let data = util::write_data(dir.path(), 3);
-    let mut config =
-        TrainConfig::cpu(2).with_epochs(30).with_batch_size(1).with_checkpoint_seconds(0.0);
-    config.model = AutoencoderConfig::spectral(2, 3, Some(8));
-    let config_path = dir.path().join("tiny.json");
-    config.save(&config_path).expect("config");
+    let (data, config_path) = kill_test_setup(dir.path(), 30);
     let exe = env!("CARGO_BIN_EXE_experiments");
     // The same command every time: sweep-k continues an interrupted run by itself.
     let start = |out: &Path| {
