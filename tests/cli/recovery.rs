@@ -103,6 +103,11 @@ fn render_set_train_recovery_and_recover_chain() {
     util::assert_clean_failure(&bad_fold, "I/N");
     assert!(manifest.contains("\"excluded\":[\"") && !manifest.contains("\"excluded\":[]"));
 
+    // An image a camera could also give (nothing lit against the dark background) is skipped
+    // with a note, not learnt from.
+    deepbrdf_render::Srgb8Image::filled(16, 16, [0, 0, 0])
+        .write_png(&set.join("img-000003.png"))
+        .unwrap();
     let run = dir.path().join("cnn");
     let out = ok(&[
         "train-recovery",
@@ -116,6 +121,12 @@ fn render_set_train_recovery_and_recover_chain() {
         "2",
     ]);
     assert!(util::stdout(&out).contains("recovery CNN"), "{}", util::stdout(&out));
+    assert!(
+        util::stderr(&out).contains("1 of 6 images skipped as unusable (image 3: a blank image"),
+        "{}",
+        util::stderr(&out)
+    );
+    assert!(util::stdout(&out).contains("on 5 images"), "{}", util::stdout(&out));
     let net = run.join("recovery");
     assert!(net.join("recovery.json").is_file());
     let recovered = dir.path().join("r.binary");

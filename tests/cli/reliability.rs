@@ -179,7 +179,7 @@ fn train_killed_at_random_moments_resumes_to_bit_identical_weights() {
 #[test]
 fn sweep_k_killed_at_random_moments_continues_to_identical_results() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let (data, config_path) = kill_test_setup(dir.path(), 30);
+    let (data, config_path) = kill_test_setup(dir.path(), 8);
     let exe = env!("CARGO_BIN_EXE_experiments");
     // The same command every time: sweep-k continues an interrupted run by itself.
     let start = |out: &Path| {

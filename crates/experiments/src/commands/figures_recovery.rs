@@ -118,6 +118,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let mut rows = Vec::new();
+    let mut skipped = Vec::new();
     let mut shown: Vec<Shown> = Vec::new();
     let mut planes: Vec<Shown> = Vec::new();
     for (name, dir) in &sets {
@@ -135,22 +136,42 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         let truth = load_tables(&set.header.materials, &cache, progress)?;
         let indices: Vec<usize> = (0..set.images.len()).collect();
         let side = network.config().input_side;
-        let inputs = set_images(&set, dir, &indices, side, progress)?;
-        let latents = network.predictor(&device)?.predict(&inputs)?;
+        let usable = set_images(&set, dir, &indices, side, progress)?;
+        if let Some(note) = usable.note(dir) {
+            eprintln!("{note}");
+        }
+        skipped.push((name.clone(), usable.unusable.len(), indices.len()));
+        let inputs = &usable.pixels;
+        let latents = network.predictor(&device)?.predict(inputs)?;
         let side7 = analytic.config().input_side;
-        let inputs7 = if side7 == side {
-            inputs.clone()
+        let attributes = if side7 == side {
+            analytic.predictor(&device)?.predict(inputs)?
         } else {
-            set_images(&set, dir, &indices, side7, progress)?
+            let again = set_images(&set, dir, &usable.indices, side7, progress)?;
+            if again.indices != usable.indices {
+                bail!(
+                    "{}: the analytic network's input side makes other images unusable",
+                    dir.display()
+                );
+            }
+            analytic.predictor(&device)?.predict(&again.pixels)?
         };
-        let attributes = analytic.predictor(&device)?.predict(&inputs7)?;
-        let nearest = nearest_materials(&set, &inputs, side, &train_tables, args.nn_spp, progress)?;
-        progress.start(set.images.len() as u64, &format!("measuring {name}"));
-        for (i, image) in set.images.iter().enumerate() {
+        let nearest = nearest_materials(
+            &set,
+            &usable.indices,
+            inputs,
+            side,
+            &train_tables,
+            args.nn_spp,
+            progress,
+        )?;
+        progress.start(usable.indices.len() as u64, &format!("measuring {name}"));
+        for (j, &i) in usable.indices.iter().enumerate() {
+            let image = &set.images[i];
             let t = &truth[&image.material];
-            let decoded = model.decode(&latents[i])?;
-            let fitted = attributes_of(&attributes[i])?.table();
-            let near = &train_tables[&nearest[i]];
+            let decoded = model.decode(&latents[j])?;
+            let fitted = attributes_of(&attributes[j])?.table();
+            let near = &train_tables[&nearest[j]];
             let recon: [&MerlTable; 4] = [&decoded, &fitted, near, &mean];
             let cfg = ImageRelaeConfig {
                 scene: novel_scene(&set, i),
@@ -218,13 +239,13 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                 shape: image.scene.scene.shape.name(),
                 relae,
                 mse,
-                nearest: nearest[i].clone(),
+                nearest: nearest[j].clone(),
             });
             progress.advance(1);
         }
         progress.finish();
     }
-    write_outputs(&args, &rows, &shown, &planes, &model, &network, &analytic)
+    write_outputs(&args, &rows, &skipped, &shown, &planes, &model, &network, &analytic)
 }
 
 /// The novel scene of image `i`: drawn from another stream than the inputs', with another
@@ -261,11 +282,12 @@ fn mean_table(tables: &[&MerlTable]) -> anyhow::Result<MerlTable> {
     Ok(MerlTable::from_values(values)?)
 }
 
-/// For each image of `set`, the training material whose render in the image's own scene
+/// For each image of `set` with these indices (`inputs` in their order), the training material whose render in the image's own scene
 /// (same seed and exposure, `spp` samples, no noise), prepared like the input, is closest to the prepared input
 /// (squared distance).
 fn nearest_materials(
     set: &RenderSet,
+    indices: &[usize],
     inputs: &[f32],
     side: usize,
     train: &BTreeMap<String, MerlTable>,
@@ -273,17 +295,19 @@ fn nearest_materials(
     progress: &dyn Progress,
 ) -> anyhow::Result<Vec<String>> {
     let per = 3 * side * side;
-    let n = set.images.len();
+    let n = indices.len();
     let mut best = vec![(f64::INFINITY, String::new()); n];
-    let scenes: Vec<deepbrdf_render::Scene> =
-        set.images.iter().map(|im| im.scene.scene.build()).collect::<Result<Vec<_>, _>>()?;
+    let scenes: Vec<deepbrdf_render::Scene> = indices
+        .iter()
+        .map(|&i| set.images[i].scene.scene.build())
+        .collect::<Result<Vec<_>, _>>()?;
     progress.start(train.len() as u64, "nearest neighbours");
     for (name, table) in train {
         let brdf = MerlBrdf::new(table);
         let distances: Vec<f64> = (0..n)
             .into_par_iter()
             .map(|i| {
-                let im = &set.images[i];
+                let im = &set.images[indices[i]];
                 let settings = RenderSettings {
                     size: set.header.size,
                     spp,
@@ -313,7 +337,7 @@ fn nearest_materials(
     }
     progress.finish();
     if let Some(i) = best.iter().position(|b| b.1.is_empty()) {
-        bail!("image {i}: no training material renders to a usable image in its scene");
+        bail!("image {}: no training material renders to a usable image in its scene", indices[i]);
     }
     Ok(best.into_iter().map(|b| b.1).collect())
 }
@@ -333,9 +357,11 @@ fn median(v: impl Iterator<Item = f64>) -> f64 {
     }
 }
 
+#[allow(clippy::too_many_arguments)]
 fn write_outputs(
     args: &Args,
     rows: &[Row],
+    skipped: &[(String, usize, usize)],
     shown: &[Shown],
     planes: &[Shown],
     model: &DeepBrdf,
@@ -373,6 +399,9 @@ fn write_outputs(
         analytic.id()
     )?;
     writeln!(md, "Novel-scene renders: {0}x{0} px, {1} spp. RelAE: image space, novel shape, view and sky; MSE: mapped space (eq. 1), the model's reference.", args.size, args.spp)?;
+    for (set, n, of) in skipped.iter().filter(|s| s.1 > 0) {
+        writeln!(md, "{set}: {n} of {of} images skipped as unusable (the checks `recover` applies to a photo: no object, no dark background, saturated).")?;
+    }
     writeln!(md)?;
     writeln!(md, "| test set | images | materials | method | RelAE mean | RelAE median | mapped MSE mean | best RelAE on |")?;
     writeln!(md, "| --- | ---: | ---: | --- | ---: | ---: | ---: | ---: |")?;

@@ -87,11 +87,19 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     }
     let indices: Vec<usize> = (0..set.images.len()).collect();
     let images = set_images(&set, &args.set, &indices, config.input_side, progress)?;
+    if let Some(note) = images.note(&args.set) {
+        eprintln!("{note}");
+    }
+    let used = images.indices.len();
     let data = RecoveryData {
         side: config.input_side,
         outputs: config.outputs,
-        images,
-        targets: set.images.iter().flat_map(|im| targets[&im.material].clone()).collect(),
+        targets: images
+            .indices
+            .iter()
+            .flat_map(|&i| targets[&set.images[i].material].clone())
+            .collect(),
+        images: images.pixels,
     };
     let session = Session::new(&args.out, args.resume, progress, "recovery");
     let trained = train_recovery(&config, &settings, &data, &session, &device, progress)?;
@@ -99,7 +107,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let provenance = RecoveryProvenance {
         set: args.set.display().to_string(),
         set_digest: set.digest(),
-        images: set.images.len(),
+        images: used,
         materials: set.header.materials.clone(),
         data_fingerprint: trained.fingerprint.clone(),
         train_config: serde_json::json!({"preset": args.preset.name(), "loop": settings}),
@@ -116,7 +124,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
          {:.0} s -> {} (id {})",
         args.preset,
         artifact.config().outputs,
-        set.images.len(),
+        used,
         trained.log[0].loss,
         last.loss,
         trained.log.len(),
