@@ -147,6 +147,61 @@ fn render_set_train_recovery_and_recover_chain() {
     assert_eq!(read_merl(&recovered).unwrap().mask(), util::material(0).mask());
     assert!(compare.is_file());
 
+    // figures-recovery: the analytic baseline (7 outputs), a test set of the fold the `held`
+    // set leaves out, every method measured in a novel scene.
+    let attr = dir.path().join("cnn-attr");
+    ok(&[
+        "train-recovery",
+        "--model",
+        &s(&model),
+        "--set",
+        &s(&set),
+        "--out",
+        &s(&attr),
+        "--epochs",
+        "1",
+        "--target",
+        "attributes",
+    ]);
+    let test = dir.path().join("test");
+    let test_args = ["--data", &s(&data), "--size", "16", "--spp", "2", "--only-fold", "0/3"];
+    ok(&[&["render-set", "--out", &s(&test), "--images", "3", "--seed", "8"][..], &test_args]
+        .concat());
+    let figures = dir.path().join("figures");
+    let fig_args = |train: &Path| {
+        let mut a = vec!["figures-recovery".to_string(), "--model".into(), s(&model)];
+        for (k, v) in [
+            ("--network", s(&net)),
+            ("--analytic", s(&attr.join("recovery"))),
+            ("--train-set", s(train)),
+            ("--test-set", s(&test)),
+            ("--out", s(&figures)),
+            ("--size", "16".into()),
+            ("--spp", "2".into()),
+            ("--nn-spp", "1".into()),
+        ] {
+            a.push(k.into());
+            a.push(v);
+        }
+        a
+    };
+    let args = fig_args(&held);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = ok(&args);
+    let summary = std::fs::read_to_string(figures.join("summary.md")).unwrap();
+    for method in ["deepbrdf", "analytic", "nearest", "mean"] {
+        assert!(summary.contains(&format!("| held-out | 3 | 1 | {method} |")), "{summary}");
+    }
+    let csv = std::fs::read_to_string(figures.join("per_image.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 4, "{csv}");
+    for f in ["fig16.png", "per_material_held-out.png"] {
+        assert!(figures.join(f).is_file(), "{f}: {}", util::stderr(&out));
+    }
+    // A test set that shares materials with the training set is not held out.
+    let args = fig_args(&set);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    util::assert_clean_failure(&util::run_in(dir.path(), &args), "not held out");
+
     // Unusable photos: blank, not an image.
     let blank = dir.path().join("blank.png");
     deepbrdf_render::Srgb8Image::filled(32, 32, [0, 0, 0]).write_png(&blank).unwrap();

@@ -18,6 +18,7 @@ use crate::recovery_inputs::{attributes_of, load_tables, set_images};
 use anyhow::{bail, Context};
 use deepbrdf_data::merl::{CELLS, INVALID_VALUE, VALUES};
 use deepbrdf_data::{MerlTable, Progress, Silent};
+use deepbrdf_eval::figures::{write_chart, LineChart, Series};
 use deepbrdf_eval::harness::{Measure, Yardstick};
 use deepbrdf_eval::metrics::{ImageRelae, ImageRelaeConfig};
 use deepbrdf_model::recovery::{RecoveryArtifact, RecoveryTarget};
@@ -425,6 +426,11 @@ fn write_outputs(
             )?;
         }
     }
+    for set in &sets {
+        writeln!(md)?;
+        writeln!(md, "![{set}, per material](per_material_{set}.png)")?;
+        per_material_chart(rows, set, &args.out.join(format!("per_material_{set}")))?;
+    }
     deepbrdf_data::files::write_atomic(&args.out.join("summary.md"), md.as_bytes())?;
     print!("{md}");
 
@@ -471,7 +477,50 @@ fn write_outputs(
         )?;
         sheet.write_png(&args.out.join("fig17.png"))?;
     }
-    eprintln!("wrote {}/summary.md, per_image.csv, fig16.png, fig17.png", args.out.display());
+    eprintln!(
+        "wrote {}/summary.md, per_image.csv, per_material_*.png, fig16.png, fig17.png",
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// The novel-scene RelAE of each method per material of test set `set` (the mean over the
+/// material's images), materials sorted by the methods' geometric mean, as `<stem>.png/.svg`.
+fn per_material_chart(rows: &[Row], set: &str, stem: &std::path::Path) -> anyhow::Result<()> {
+    let rs: Vec<&Row> = rows.iter().filter(|r| r.set == set).collect();
+    let mut materials: Vec<&str> = rs.iter().map(|r| r.material.as_str()).collect();
+    materials.sort();
+    materials.dedup();
+    let value = |material: &str, m: usize| {
+        mean(rs.iter().filter(|r| r.material == material).map(|r| r.relae[m]))
+    };
+    let key =
+        |material: &str| (0..METHODS.len()).map(|m| value(material, m).max(1e-9).ln()).sum::<f64>();
+    materials.sort_by(|a, b| key(a).total_cmp(&key(b)));
+    let series = METHODS
+        .iter()
+        .enumerate()
+        .map(|(m, method)| Series {
+            label: method.to_string(),
+            points: materials.iter().enumerate().map(|(x, n)| (x as f64, value(n, m))).collect(),
+        })
+        .collect();
+    let chart = LineChart {
+        title: format!(
+            "recovery, {set}: novel-scene image RelAE per material (mean over its images)"
+        ),
+        x_label: "material".into(),
+        y_label: "image RelAE".into(),
+        log_y: true,
+        series,
+        categories: Some(
+            materials.iter().map(|m| m.rsplit('/').next().unwrap_or(m).to_string()).collect(),
+        ),
+        rotate_categories: true,
+        legend_left: true,
+        size: ((300 + 14 * materials.len() as u32).clamp(900, 2600), 520),
+    };
+    write_chart(&chart, stem)?;
     Ok(())
 }
 
