@@ -1,6 +1,7 @@
 //! CLI tests of what happens around a run rather than inside it (issue 15): two runs on one
-//! output folder, the lock of a killed run, a full disk and a read-only folder, and `train` and
-//! `sweep-k` killed at random moments ([`kill`]).
+//! output folder, the lock of a killed run, a full disk and a read-only folder, and the long
+//! jobs (`train`, `sweep-k`, `render-set`, `train-recovery`) killed at random moments
+//! ([`kill`]).
 //!
 //! The disk tests mount a small tmpfs inside a private user and mount namespace
 //! (`unshare --user --map-root-user --mount`), so they need no privileges and leave no mount
@@ -210,4 +211,94 @@ fn sweep_k_killed_at_random_moments_continues_to_identical_results() {
         outputs: &outputs,
     };
     kill::kill_trials(&job, dir.path(), kill::trials(1), &|_| {});
+}
+
+/// A render set of `images` 32-px images of `data`'s materials in `out` (`-q`).
+fn render_set_command(data: &Path, out: &Path, images: usize) -> Command {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_experiments"));
+    cmd.args(["render-set", "--out", &s(out), "--data", &s(data), "--images"]).args([
+        images.to_string().as_str(),
+        "--size",
+        "32",
+        "--spp",
+        "8",
+        "--seed",
+        "3",
+        "-q",
+    ]);
+    cmd
+}
+
+#[test]
+fn render_set_killed_at_random_moments_finishes_to_identical_images() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (data, _) = kill_test_setup(dir.path(), 1);
+    let images = 240;
+    let names: Vec<String> = std::iter::once("manifest.json".to_string())
+        .chain((0..images).map(|i| format!("img-{i:06}.png")))
+        .collect();
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let outputs = |out: &Path| kill::files(out, &names);
+    let job = kill::Job {
+        name: "render-set",
+        start: &|out: &Path| spawn(render_set_command(&data, out, images)),
+        progress: &|out: &Path| out.join("img-000000.png"),
+        outputs: &outputs,
+    };
+    // No temporary file of a killed write is left: the next run's lock removes them.
+    let check = |out: &Path| {
+        let stray: Vec<String> = std::fs::read_dir(out)
+            .expect("set folder")
+            .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+            .filter(|n| !names.contains(&n.as_str()) && n != deepbrdf_data::lock::LOCK_FILE)
+            .collect();
+        assert!(stray.is_empty(), "files left by killed runs: {stray:?}");
+    };
+    kill::kill_trials(&job, dir.path(), kill::trials(2), &check);
+}
+
+#[test]
+fn train_recovery_killed_at_random_moments_resumes_to_bit_identical_weights() {
+    use deepbrdf_model::train::checkpoint_path;
+
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (data, config_path) = kill_test_setup(dir.path(), 2);
+    let model = dir.path().join("model");
+    let o = util::run_in(
+        dir.path(),
+        &["train", "--config", &s(&config_path), "--data", &s(&data), "--out", &s(&model)],
+    );
+    assert!(o.status.success(), "{}", util::stderr(&o));
+    let set = dir.path().join("set");
+    let o = render_set_command(&data, &set, 12).output().expect("render-set");
+    assert!(o.status.success(), "{}", util::stderr(&o));
+    let exe = env!("CARGO_BIN_EXE_experiments");
+    // A checkpoint after every epoch; --resume once one exists.
+    let start = |out: &Path| {
+        let mut cmd = Command::new(exe);
+        cmd.args(["train-recovery", "--model", &s(&model), "--set", &s(&set), "--out", &s(out)])
+            .args(["--epochs", "20", "--checkpoint-seconds", "0", "-q"]);
+        if checkpoint_path(out).is_file() {
+            cmd.arg("--resume");
+        }
+        spawn(cmd)
+    };
+    // recovery.json records the training time, so it is left out of the comparison.
+    let outputs = |out: &Path| kill::files(out, &["recovery/weights.bpk", "train_log.csv"]);
+    let job = kill::Job {
+        name: "train-recovery",
+        start: &start,
+        progress: &|out: &Path| checkpoint_path(out),
+        outputs: &outputs,
+    };
+    // The network recovers a material from a set image.
+    let check = |out: &Path| {
+        let net = s(&out.join("recovery"));
+        let image = s(&set.join("img-000001.png"));
+        let r = s(&out.join("r.binary"));
+        let args = ["recover", "--model", &s(&model), "--network", &net, &image, "-o", &r];
+        let o = util::run_in(dir.path(), &args);
+        assert!(o.status.success(), "{}", util::stderr(&o));
+    };
+    kill::kill_trials(&job, dir.path(), kill::trials(2), &check);
 }

@@ -7,6 +7,8 @@
 //! message. The operating system releases the lock when its holder exits, however it exits, so a
 //! stale lock file left by a dead process is simply locked again by the next run; no pid liveness
 //! guessing is involved. The file stays in the folder after the run (a hidden file of a few bytes).
+//! Taking the lock removes the temporary files a killed run left in the folder
+//! ([`crate::files::remove_stale_temporaries`]).
 
 use crate::error::{DataError, Result};
 use std::fs::{File, OpenOptions, TryLockError};
@@ -60,6 +62,8 @@ impl FolderLock {
         file.seek(SeekFrom::Start(0)).map_err(|e| DataError::io(&path, e))?;
         file.write_all(record.as_bytes()).map_err(|e| DataError::io(&path, e))?;
         file.sync_all().map_err(|e| DataError::io(&path, e))?;
+        // Whatever a killed run of this folder was writing is garbage now.
+        crate::files::remove_stale_temporaries(dir)?;
         Ok(Self { path, file })
     }
 

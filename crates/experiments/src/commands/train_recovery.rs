@@ -41,6 +41,10 @@ pub struct Args {
     /// Seed of the initialisation, batches and mirroring.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Write a checkpoint at the end of an epoch once this many seconds have passed since the
+    /// last (default: the preset's, 30 s for cpu); 0 checkpoints every epoch.
+    #[arg(long, value_name = "S")]
+    pub checkpoint_seconds: Option<f64>,
     /// Continue an interrupted run in --out.
     #[arg(long)]
     pub resume: bool,
@@ -84,6 +88,9 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let mut settings = args.preset.loop_config().with_seed(args.seed);
     if let Some(e) = args.epochs {
         settings = settings.with_epochs(e);
+    }
+    if let Some(c) = args.checkpoint_seconds {
+        settings = settings.with_checkpoint_seconds(c);
     }
     let indices: Vec<usize> = (0..set.images.len()).collect();
     let images = set_images(&set, &args.set, &indices, config.input_side, progress)?;
