@@ -105,23 +105,58 @@ impl Image {
     /// Reads an OpenEXR file written by [`Image::write_exr`] (or any RGB(A) EXR; missing alpha
     /// reads as full coverage).
     pub fn read_exr(path: &Path) -> Result<Self> {
-        use exr::prelude::read_first_rgba_layer_from_file;
-        let image = read_first_rgba_layer_from_file(
-            path,
-            |resolution, _| {
-                let (w, h) = (resolution.width(), resolution.height());
-                (w, vec![[0.0f32; 4]; w * h])
-            },
-            |(w, pixels): &mut (usize, Vec<[f32; 4]>), pos, (r, g, b, a): (f32, f32, f32, f32)| {
-                pixels[pos.y() * *w + pos.x()] = [r, g, b, a];
-            },
-        )
-        .map_err(|e| RenderError::format(path, format!("not a readable RGB EXR image: {e}")))?;
+        let bytes = std::fs::read(path)
+            .map_err(|e| RenderError::format(path, format!("cannot read: {e}")))?;
+        Self::exr_from_bytes(&bytes, path)
+    }
+
+    /// [`Image::read_exr`] of a file's bytes (`origin` names it in errors). The header is read
+    /// first and a layer larger than [`crate::integrator::MAX_SIZE`] on a side is refused
+    /// before any pixel memory is allocated.
+    pub fn exr_from_bytes(bytes: &[u8], origin: &Path) -> Result<Self> {
+        use exr::prelude::*;
+        let bad = |e: exr::error::Error| {
+            RenderError::format(origin, format!("not a readable RGB EXR image: {e}"))
+        };
+        let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
+            .map_err(bad)?;
+        let max = crate::integrator::MAX_SIZE as usize;
+        for header in &meta.headers {
+            let size = header.layer_size;
+            if size.width() > max || size.height() > max {
+                return Err(RenderError::format(
+                    origin,
+                    format!(
+                        "a {}x{} EXR layer: each side must be at most {max} pixels",
+                        size.width(),
+                        size.height()
+                    ),
+                ));
+            }
+        }
+        let image = read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .rgba_channels(
+                |resolution, _| {
+                    let (w, h) = (resolution.width(), resolution.height());
+                    (w, vec![[0.0f32; 4]; w * h])
+                },
+                |(w, pixels): &mut (usize, Vec<[f32; 4]>),
+                 pos,
+                 (r, g, b, a): (f32, f32, f32, f32)| {
+                    pixels[pos.y() * *w + pos.x()] = [r, g, b, a];
+                },
+            )
+            .first_valid_layer()
+            .all_attributes()
+            .from_buffered(std::io::Cursor::new(bytes))
+            .map_err(bad)?;
         let size = image.layer_data.size;
         let (_, pixels) = image.layer_data.channel_data.pixels;
         let (w, h) = (u32::try_from(size.width()), u32::try_from(size.height()));
         let (Ok(w), Ok(h)) = (w, h) else {
-            return Err(RenderError::format(path, "image too large"));
+            return Err(RenderError::format(origin, "image too large"));
         };
         let rgb = pixels.iter().map(|p| [p[0], p[1], p[2]]).collect();
         let coverage = pixels.iter().map(|p| p[3]).collect();

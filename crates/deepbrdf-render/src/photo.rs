@@ -26,8 +26,15 @@ const MAX_SATURATED_FRACTION: f64 = 0.5;
 /// Margin of the square crop around the object's bounding box, per side, as a fraction of the
 /// box's larger side (the renderer's camera frames its shapes with 4%).
 const CROP_MARGIN: f64 = 0.04;
-/// Largest image side read (a 16384-pixel square is 3 GB of f32 pixels).
-pub const MAX_PHOTO_SIDE: u32 = 16384;
+/// Largest image side read: an 8192-pixel square is 0.8 GB as f32 RGB (a 12-megapixel
+/// camera photo, 0.14 GB).
+pub const MAX_PHOTO_SIDE: u32 = 8192;
+/// Largest photo file read.
+pub const MAX_PHOTO_BYTES: u64 = 1 << 30;
+/// Most memory the PNG/JPEG decoder may allocate (an 8192-pixel square of 16-bit RGBA).
+const MAX_DECODE_BYTES: u64 = 8192 * 8192 * 8;
+/// The first four bytes of an OpenEXR file.
+const EXR_MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
 
 /// A decoded photo: display-encoded RGB in [0, 1] and, if the file has one, its alpha.
 #[derive(Clone, Debug, PartialEq)]
@@ -43,26 +50,44 @@ impl Photo {
     /// or an OpenEXR file (linear radiance, clipped to [0, 1] and sRGB-encoded; its alpha, as
     /// the renderer writes coverage).
     pub fn read(path: &Path) -> Result<Self> {
-        let is_exr = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-        if is_exr {
-            let image = Image::read_exr(path)?;
-            return Ok(Self::from_linear(&image));
-        }
-        let reader = image::ImageReader::open(path)
+        let len = std::fs::metadata(path)
             .map_err(|e| RenderError::format(path, format!("cannot open: {e}")))?
-            .with_guessed_format()
+            .len();
+        if len > MAX_PHOTO_BYTES {
+            return Err(RenderError::format(
+                path,
+                format!("{len} bytes: larger than the {MAX_PHOTO_BYTES} bytes a photo may have"),
+            ));
+        }
+        let bytes = std::fs::read(path)
             .map_err(|e| RenderError::format(path, format!("cannot read: {e}")))?;
-        let (w, h) = reader.into_dimensions().map_err(|e| {
-            RenderError::format(path, format!("not a readable PNG, JPEG or EXR image: {e}"))
-        })?;
-        check_size(path, w, h)?;
-        let decoded = image::ImageReader::open(path)
-            .and_then(|r| r.with_guessed_format())
-            .map_err(|e| RenderError::format(path, format!("cannot read: {e}")))?
-            .decode()
-            .map_err(|e| {
-                RenderError::format(path, format!("not a readable PNG, JPEG or EXR image: {e}"))
-            })?;
+        Self::from_bytes(&bytes, path)
+    }
+
+    /// [`Photo::read`] of a file's bytes; `origin` names the file in errors. OpenEXR is told by
+    /// its magic number, PNG and JPEG by theirs; the image's size is checked from its header
+    /// before its pixels are decoded, and the decoder's allocations are limited.
+    pub fn from_bytes(bytes: &[u8], origin: &Path) -> Result<Self> {
+        if bytes.starts_with(&EXR_MAGIC) {
+            return Ok(Self::from_linear(&Image::exr_from_bytes(bytes, origin)?));
+        }
+        let unreadable = |e: image::ImageError| {
+            RenderError::format(origin, format!("not a readable PNG, JPEG or EXR image: {e}"))
+        };
+        let reader = || {
+            let mut limits = image::Limits::default();
+            limits.max_image_width = Some(MAX_PHOTO_SIDE);
+            limits.max_image_height = Some(MAX_PHOTO_SIDE);
+            limits.max_alloc = Some(MAX_DECODE_BYTES);
+            let mut r = image::ImageReader::new(std::io::Cursor::new(bytes))
+                .with_guessed_format()
+                .map_err(|e| RenderError::format(origin, format!("cannot read: {e}")))?;
+            r.limits(limits);
+            Ok::<_, RenderError>(r)
+        };
+        let (w, h) = reader()?.into_dimensions().map_err(unreadable)?;
+        check_size(origin, w, h)?;
+        let decoded = reader()?.decode().map_err(unreadable)?;
         let has_alpha = decoded.color().has_alpha();
         let rgba = decoded.into_rgba32f();
         let (width, height) = rgba.dimensions();
@@ -307,6 +332,65 @@ mod tests {
         }
         let e = why(&white);
         assert!(e.contains("saturated") && e.starts_with("p.png"), "{e}");
+    }
+
+    /// Small files of every format `Photo` reads: PNG (RGB and RGBA), JPEG, EXR.
+    fn corpus(dir: &Path) -> Vec<Vec<u8>> {
+        use image::ImageFormat;
+        let img = disk(40, 14.0, 180);
+        let encode = |image: image::DynamicImage, format: ImageFormat| {
+            let mut bytes = Vec::new();
+            image.write_to(&mut std::io::Cursor::new(&mut bytes), format).unwrap();
+            bytes
+        };
+        let rgb = image::RgbImage::from_raw(40, 40, img.data.clone()).unwrap();
+        let rgba = image::RgbaImage::from_fn(40, 40, |x, y| {
+            let p = rgb.get_pixel(x, y);
+            image::Rgba([p[0], p[1], p[2], if p[0] > 0 { 255 } else { 0 }])
+        });
+        let linear: Vec<[f32; 3]> =
+            (0..40 * 40).map(|i| [0.3, 0.1, (i % 7) as f32 * 0.01]).collect();
+        let cov: Vec<f32> = (0..40 * 40).map(|i| if (i / 40) < 20 { 1.0 } else { 0.0 }).collect();
+        let exr = dir.join("c.exr");
+        Image::from_pixels(40, 40, linear, cov).unwrap().write_exr(&exr).unwrap();
+        vec![
+            encode(rgb.clone().into(), ImageFormat::Png),
+            encode(rgba.into(), ImageFormat::Png),
+            encode(rgb.into(), ImageFormat::Jpeg),
+            std::fs::read(&exr).unwrap(),
+        ]
+    }
+
+    #[test]
+    fn mutated_photos_are_read_or_refused_never_a_panic() {
+        use deepbrdf_data::testing::mutate::{fuzz, inputs, Focus};
+        let dir = tempfile::tempdir().unwrap();
+        let corpus = corpus(dir.path());
+        for bytes in &corpus {
+            Photo::from_bytes(bytes, Path::new("seed")).unwrap().network_input(16, "seed").unwrap();
+        }
+        let n = inputs(2000);
+        let origin = Path::new("fuzz.img");
+        let report = fuzz(&corpus, 2027, n, Focus { header: 96, header_share: 0.7 }, |b| {
+            Photo::from_bytes(b, origin).and_then(|p| p.network_input(16, "fuzz.img"))
+        });
+        eprintln!("photo reader: {report:?}");
+        assert!(report.panics.is_empty(), "panics: {:?}", report.panics);
+        assert!(report.accepted > 0 && report.rejected > 0, "{report:?}");
+    }
+
+    #[test]
+    fn an_exr_larger_than_the_limit_is_refused_before_its_pixels_are_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let wide = crate::integrator::MAX_SIZE + 1;
+        let n = wide as usize;
+        let path = dir.path().join("wide.exr");
+        Image::from_pixels(wide, 1, vec![[0.5; 3]; n], vec![1.0; n])
+            .unwrap()
+            .write_exr(&path)
+            .unwrap();
+        let e = Photo::read(&path).unwrap_err().to_string();
+        assert!(e.contains("wide.exr") && e.contains("at most 8192"), "{e}");
     }
 
     #[test]
