@@ -253,4 +253,9 @@ fn render_set_train_recovery_and_recover_chain() {
         ],
     );
     util::assert_clean_failure(&o, "train-recovery");
+    // The help states what a usable photo is.
+    let help = util::stdout(&ok(&["recover", "--help"]));
+    for needle in ["object", "centred", "sun-and-sky", "background", "alpha"] {
+        assert!(help.contains(needle), "recover --help lacks '{needle}': {help}");
+    }
 }

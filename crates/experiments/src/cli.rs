@@ -59,6 +59,12 @@ pub enum Command {
     /// attributes); resumable.
     TrainRecovery(commands::train_recovery::Args),
     /// Recover a MERL BRDF from one photo of an object (§5.2).
+    ///
+    /// Assumptions: one object of one homogeneous, isotropic material, roughly centred and
+    /// wholly in view, lit by a sun-and-sky-like outdoor light, in front of a plain dark
+    /// background (or cut out by an alpha channel); PNG, JPEG or EXR of any size (the object is
+    /// cropped and resized to the network's input). Blank, saturated or object-less photos are
+    /// refused with the reason.
     Recover(commands::recover::Args),
     /// Measure single-image recovery against its baselines on held-out and other materials;
     /// the table, Fig. 16 and Fig. 17 under results/recovery.

@@ -13,12 +13,7 @@ use deepbrdf_render::{render, MerlBrdf, Photo, RenderSettings, SceneConfig, Srgb
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Recover a MERL BRDF from one photo of an object.
-///
-/// Assumptions: one object of one homogeneous, isotropic material, roughly centred and wholly
-/// in view, lit by a sun-and-sky-like outdoor light, in front of a plain dark background (or
-/// cut out by an alpha channel); PNG, JPEG or EXR of any size (the object is cropped and
-/// resized to the network's input). Blank, saturated or object-less photos are refused.
+/// The arguments of `recover` (its assumptions about the photo: the command's help in `cli.rs`).
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(flatten)]
