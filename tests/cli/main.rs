@@ -13,4 +13,5 @@ mod model;
 mod recovery;
 mod reliability;
 mod render;
+mod shipped;
 mod sweep_k;

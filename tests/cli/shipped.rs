@@ -1,0 +1,43 @@
+//! The model shipped in the repository (`models/default`) works right after a clone: `encode`,
+//! `decode` and `edit` without `--model` use it, with its editing regressor, and `recover`
+//! uses its recovery network.
+use crate::util;
+use deepbrdf_data::merl::read_merl;
+use std::path::Path;
+
+fn s(p: &Path) -> String {
+    p.to_str().unwrap().to_string()
+}
+
+#[test]
+fn the_shipped_model_encodes_decodes_edits_and_recovers_without_model_options() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = util::write_data(dir.path(), 1);
+    let m0 = s(&data.join("m0.binary"));
+    let ok = |args: &[&str]| {
+        let out = util::run_in(dir.path(), args);
+        assert!(out.status.success(), "{args:?}: {}", util::stderr(&out));
+        out
+    };
+    let manifest: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/default/model/model.json"),
+        )
+        .unwrap(),
+    )
+    .unwrap();
+    let id = manifest["id"].as_str().unwrap().to_string();
+
+    let latent = dir.path().join("m0.json");
+    ok(&["encode", &m0, "-o", &s(&latent)]);
+    let text = std::fs::read_to_string(&latent).unwrap();
+    assert!(text.contains(&id), "the latent names the shipped model {id}: {text}");
+    let decoded = dir.path().join("d.binary");
+    ok(&["decode", &s(&latent), "-o", &s(&decoded)]);
+    assert_eq!(read_merl(&decoded).unwrap().mask(), util::material(0).mask());
+
+    let edited = dir.path().join("e.binary");
+    let out = ok(&["edit", &m0, "--diffuse-scale", "0.5", "-o", &s(&edited)]);
+    assert!(util::stdout(&out).contains(&id), "{}", util::stdout(&out));
+    assert!(read_merl(&edited).is_ok());
+}
