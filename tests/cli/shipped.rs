@@ -40,4 +40,13 @@ fn the_shipped_model_encodes_decodes_edits_and_recovers_without_model_options() 
     let out = ok(&["edit", &m0, "--diffuse-scale", "0.5", "-o", &s(&edited)]);
     assert!(util::stdout(&out).contains(&id), "{}", util::stdout(&out));
     assert!(read_merl(&edited).is_ok());
+
+    // A photo of the material (a render over black), recovered with the shipped network.
+    let photo = dir.path().join("photo.png");
+    ok(&["render", &m0, "-o", &s(&photo), "--size", "64", "--spp", "4"]);
+    let recovered = dir.path().join("r.binary");
+    let compare = dir.path().join("c.png");
+    let out = ok(&["recover", &s(&photo), "-o", &s(&recovered), "--render", &s(&compare)]);
+    assert_eq!(read_merl(&recovered).unwrap().mask(), util::material(0).mask());
+    assert!(compare.is_file(), "{}", util::stdout(&out));
 }
