@@ -13,4 +13,5 @@ mod model;
 mod recovery;
 mod reliability;
 mod render;
+mod serve;
 mod sweep_k;

@@ -91,16 +91,28 @@ impl Space<'_> {
         mode: EditMode,
     ) -> anyhow::Result<Edited> {
         let requested = edit.apply(original)?;
-        let target = self.latent_of(&requested)?;
-        let latent = match mode {
+        let latent = self.edited_latent(latent, original, &requested, mode)?;
+        let table = self.codec.decode(&latent)?;
+        Ok(Edited { requested, table })
+    }
+
+    /// The latent of the edit from `original` (latent `latent`, used by the residual edit) to
+    /// the attributes `requested` (checked by [`Edit::apply`]), before decoding.
+    pub fn edited_latent(
+        &self,
+        latent: &[f32],
+        original: &Attributes,
+        requested: &Attributes,
+        mode: EditMode,
+    ) -> anyhow::Result<Vec<f32>> {
+        let target = self.latent_of(requested)?;
+        Ok(match mode {
             EditMode::Paper => target,
             EditMode::Residual => {
                 let base = self.latent_of(original)?;
                 latent.iter().zip(target.iter().zip(&base)).map(|(y, (t, b))| y + t - b).collect()
             }
-        };
-        let table = self.codec.decode(&latent)?;
-        Ok(Edited { requested, table })
+        })
     }
 }
 

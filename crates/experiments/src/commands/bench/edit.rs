@@ -71,14 +71,7 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     for rep in 0..=args.reps.max(1) {
         let t0 = Instant::now();
         let requested = edit.apply(&original)?;
-        let target = space.latent_of(&requested)?;
-        let z: Vec<f32> = match mode {
-            EditMode::Paper => target,
-            EditMode::Residual => {
-                let base = space.latent_of(&original)?;
-                latent.iter().zip(target.iter().zip(&base)).map(|(y, (t, b))| y + t - b).collect()
-            }
-        };
+        let z = space.edited_latent(&latent, &original, &requested, mode)?;
         let t1 = Instant::now();
         let edited = codec.decode(&z)?;
         let t2 = Instant::now();
