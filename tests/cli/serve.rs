@@ -155,7 +155,7 @@ fn serve_refuses_bad_input_with_4xx_and_keeps_running() {
     for (name, bytes, want, needle) in [
         ("../evil.binary", vec![0u8; 10], 400, "no path"),
         ("notes.txt", vec![0u8; 10], 400, ".binary or .bsdf"),
-        ("short.binary", vec![0u8; 100], 400, "truncated"),
+        ("short.binary", vec![0u8; 100], 400, "not a MERL .binary"),
         ("bad.bsdf", b"not a tensor file".to_vec(), 400, "bad.bsdf"),
         ("huge.binary", vec![0u8; 65 << 20], 413, "larger than"),
     ] {
@@ -197,7 +197,14 @@ fn serve_refuses_bad_input_with_4xx_and_keeps_running() {
     assert_eq!(status, 200);
     let latent: Value = serde_json::from_slice(&latent).unwrap();
     assert_eq!(latent["k"].as_u64().unwrap() as usize, latent["latent"].as_array().unwrap().len());
-    assert_eq!(latent["latent"], p["latent"], "the latent downloaded is the one previewed");
+    let values = |v: &Value| -> Vec<f32> {
+        v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap() as f32).collect()
+    };
+    assert_eq!(
+        values(&latent["latent"]),
+        values(&p["latent"]),
+        "the latent downloaded is the one previewed"
+    );
 
     // Still answering; nothing written beside its cache.
     assert_eq!(get(base, "/api/info").0, 200);
@@ -291,7 +298,7 @@ fn serve_page_edits_in_headless_chromium_and_downloads_a_merl_file() {
             json!({
                 "binary": chrome,
                 "args": ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-                         "--window-size=1280,1000", "--hide-scrollbars"],
+                         "--window-size=1200,880", "--hide-scrollbars"],
                 "prefs": {"download.default_directory": downloads,
                           "download.prompt_for_download": false},
             }),

@@ -212,7 +212,7 @@ impl EditorHandle {
                     let info = ModelInfo {
                         model_id: model.id().to_string(),
                         k: model.k(),
-                        model_dir: dir.display().to_string(),
+                        model_dir: dir.canonicalize().unwrap_or(dir).display().to_string(),
                     };
                     let _ = ready_tx.send(Ok(info));
                     Editor::new(model, regressor, cache, worker_catalogue, worker_shared).run();
