@@ -3,6 +3,7 @@
 //! One home for what `edit`, `interpolate`, `figures-editing` and `bench edit` share: the
 //! paper's edit `Y' = Phi(alpha')`, the residual edit `Y' = Y + Phi(alpha') - Phi(alpha)`, the
 //! latent blend, and where a model's regressors live.
+use crate::model_arg::ModelArg;
 use anyhow::{bail, Context};
 use deepbrdf_data::MerlTable;
 use deepbrdf_eval::attributes::{self, Attributes, FitConfig};
@@ -14,6 +15,17 @@ use deepbrdf_model::regressor::{Regressor, TargetKind};
 use deepbrdf_model::DeepBrdf;
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
+
+/// The options naming what the editing commands (`edit`, `figures-editing`, `serve`, `bench
+/// edit`, `bench serve`) edit with: the model (`--model DIR`) and its regressor.
+#[derive(Debug, Clone, clap::Args)]
+pub struct EditorArg {
+    #[command(flatten)]
+    pub model: ModelArg,
+    /// The regressor folder [default: <model>/regressor].
+    #[arg(long, value_name = "DIR")]
+    pub regressor: Option<PathBuf>,
+}
 
 /// Name of the folder holding a model's regressors, inside the model directory.
 pub const REGRESSOR_DIR: &str = "regressor";

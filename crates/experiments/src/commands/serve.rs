@@ -3,22 +3,18 @@
 //! the original and the edited material side by side, download the edited `.binary` and its
 //! latent. Binds 127.0.0.1 unless told otherwise; see [`crate::serve`].
 use crate::data_args::CacheArg;
-use crate::model_arg::ModelArg;
+use crate::editing::EditorArg;
 use crate::serve::editor::EditorHandle;
 use crate::serve::request::{bundled_ids, Catalogue};
 use anyhow::Context;
 use deepbrdf_data::Progress;
 use std::io::Write;
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
-use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(flatten)]
-    pub model: ModelArg,
-    /// The regressor folder [default: <model>/regressor].
-    #[arg(long, value_name = "DIR")]
-    pub regressor: Option<PathBuf>,
+    pub editor: EditorArg,
     /// Address to listen on (another than loopback lets other machines edit with this one).
     #[arg(long, value_name = "ADDR", default_value_t = IpAddr::V4(Ipv4Addr::LOCALHOST))]
     pub host: IpAddr,
@@ -33,14 +29,14 @@ pub struct Args {
 /// handle, shared by `serve` and `bench serve`.
 pub fn start(
     runtime: &tokio::runtime::Runtime,
-    model: &ModelArg,
-    regressor: Option<&std::path::Path>,
+    editor: &EditorArg,
     cache: &CacheArg,
     addr: SocketAddr,
 ) -> anyhow::Result<(tokio::net::TcpListener, EditorHandle)> {
-    let model_dir = model.dir()?;
+    let model_dir = editor.model.dir()?;
     let catalogue = Catalogue::new(bundled_ids()?);
-    let editor = EditorHandle::start(&model_dir, regressor, cache.cache(), catalogue)?;
+    let editor =
+        EditorHandle::start(&model_dir, editor.regressor.as_deref(), cache.cache(), catalogue)?;
     let listener = runtime
         .block_on(tokio::net::TcpListener::bind(addr))
         .with_context(|| format!("listening on {addr}"))?;
@@ -56,8 +52,7 @@ pub fn runtime() -> anyhow::Result<tokio::runtime::Runtime> {
 pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     let runtime = runtime()?;
     let addr = SocketAddr::new(args.host, args.port);
-    let (listener, editor) =
-        start(&runtime, &args.model, args.regressor.as_deref(), &args.cache, addr)?;
+    let (listener, editor) = start(&runtime, &args.editor, &args.cache, addr)?;
     let local = listener.local_addr()?;
     println!(
         "editing with model {} (k = {}) from {}",

@@ -19,10 +19,10 @@
 pub mod editor;
 pub mod request;
 
-use axum::body::Bytes;
-use axum::extract::rejection::{BytesRejection, JsonRejection, QueryRejection};
+use axum::body::Body;
+use axum::extract::rejection::{JsonRejection, QueryRejection};
 use axum::extract::{DefaultBodyLimit, Query, State};
-use axum::http::{header, HeaderValue, StatusCode};
+use axum::http::{header, HeaderMap, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
 use axum::{Json, Router};
@@ -140,17 +140,23 @@ struct UploadQuery {
 async fn upload(
     State(editor): State<EditorHandle>,
     query: Result<Query<UploadQuery>, QueryRejection>,
-    body: Result<Bytes, BytesRejection>,
+    headers: HeaderMap,
+    body: Body,
 ) -> ApiResult<Response> {
     let Query(q) = query.map_err(|e| ApiError(StatusCode::BAD_REQUEST, e.body_text()))?;
-    let body = body.map_err(|e| match e.status() {
-        StatusCode::PAYLOAD_TOO_LARGE => ApiError(
+    request::check_upload_name(&q.name)?;
+    let too_large = || {
+        ApiError(
             StatusCode::PAYLOAD_TOO_LARGE,
             format!("upload larger than {} MiB", UPLOAD_LIMIT >> 20),
-        ),
-        status => ApiError(status, e.body_text()),
-    })?;
-    request::check_upload_name(&q.name)?;
+        )
+    };
+    // Refused from its announced length at once, before any of it is read.
+    let announced = headers.get(header::CONTENT_LENGTH).and_then(|v| v.to_str().ok()?.parse().ok());
+    if announced.is_some_and(|n: u64| n > UPLOAD_LIMIT as u64) {
+        return Err(too_large());
+    }
+    let body = axum::body::to_bytes(body, UPLOAD_LIMIT).await.map_err(|_| too_large())?;
     Ok(Json(editor.upload(q.name, body.to_vec()).await?).into_response())
 }
 

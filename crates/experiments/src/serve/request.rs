@@ -131,9 +131,7 @@ impl SceneChoice {
     pub fn config(&self) -> Checked<SceneConfig> {
         let shape: Shape = self.shape.parse().map_err(|e| bad(format!("{e}")))?;
         let in_range = |v: f64, lo: f64, hi: f64| v.is_finite() && v >= lo && v <= hi;
-        if !(self.sun_elevation.is_finite() && self.sun_elevation > 0.0)
-            || !in_range(self.sun_elevation, 0.0, 90.0)
-        {
+        if !(in_range(self.sun_elevation, 0.0, 90.0) && self.sun_elevation > 0.0) {
             return Err(bad(format!(
                 "sun elevation {} must be in (0, 90] degrees",
                 self.sun_elevation

@@ -6,23 +6,20 @@
 //! refined previews; and a burst of 20 roughness moves 50 ms apart sent without waiting (the
 //! worst case: the page itself keeps one in flight), with the page and `/api/info` fetched
 //! during the burst.
+use super::median;
 use crate::commands::serve::{runtime, start};
 use crate::data_args::CacheArg;
-use crate::model_arg::ModelArg;
+use crate::editing::EditorArg;
 use anyhow::{bail, Context};
 use deepbrdf_data::Progress;
 use serde_json::{json, Value};
 use std::net::{Ipv4Addr, SocketAddr};
-use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(flatten)]
-    pub model: ModelArg,
-    /// The regressor folder [default: <model>/regressor].
-    #[arg(long, value_name = "DIR")]
-    pub regressor: Option<PathBuf>,
+    pub editor: EditorArg,
     /// The material to edit (a bundled id).
     #[arg(default_value = "merl/red-plastic")]
     pub material: String,
@@ -31,11 +28,6 @@ pub struct Args {
     pub reps: usize,
     #[command(flatten)]
     pub cache: CacheArg,
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 fn max(v: &[f64]) -> f64 {
@@ -59,14 +51,15 @@ impl Client {
             .send(body.to_string())
             .with_context(|| format!("POST {path}"))?;
         let status = r.status().as_u16();
-        let text = r.body_mut().with_config().limit(64 << 20).read_to_string()?;
+        let bytes = r.body_mut().with_config().limit(64 << 20).read_to_vec()?;
+        let text = String::from_utf8_lossy(&bytes).into_owned();
         Ok((status, text, t.elapsed().as_secs_f64()))
     }
 
     fn get(&self, path: &str) -> anyhow::Result<f64> {
         let t = Instant::now();
         let mut r = self.agent.get(format!("{}{path}", self.base)).call()?;
-        r.body_mut().read_to_string()?;
+        r.body_mut().read_to_vec()?;
         Ok(t.elapsed().as_secs_f64())
     }
 
@@ -92,8 +85,7 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     let runtime = runtime()?;
     let t = Instant::now();
     let addr = SocketAddr::from((Ipv4Addr::LOCALHOST, 0));
-    let (listener, editor) =
-        start(&runtime, &args.model, args.regressor.as_deref(), &args.cache, addr)?;
+    let (listener, editor) = start(&runtime, &args.editor, &args.cache, addr)?;
     let load = t.elapsed().as_secs_f64();
     let base = format!("http://{}", listener.local_addr()?);
     let model = editor.model.clone();
@@ -107,10 +99,10 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         bail!("opening {}: HTTP {status}: {text}", args.material);
     }
     let opened: Value = serde_json::from_str(&text)?;
-    let r0 = opened["attributes"]["roughness"].as_f64().context("the material's roughness")?;
+    opened["attributes"]["roughness"].as_f64().context("the material's roughness")?;
     let (_, _, original) = client.post("/api/original", &json!({"material": args.material}))?;
-    // Roughness values around the material's, each new (a new latent to decode).
-    let value = |i: usize| (r0 * (0.5 + 0.05 * i as f64)).clamp(0.001, 1.0);
+    // A new roughness value for every preview (a new latent to decode), 0.02 ... 0.18.
+    let value = |i: usize| 0.02 * 1.01f64.powi(i as i32);
     // One warm-up.
     client.preview(&args.material, value(0), "fast")?;
     let (mut trip, mut server, mut decode, mut render) = (vec![], vec![], vec![], vec![]);
