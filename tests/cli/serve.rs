@@ -202,6 +202,25 @@ fn serve_refuses_bad_input_with_4xx_and_keeps_running() {
     assert!(p["image"].as_str().unwrap().starts_with("data:image/png;base64,"));
     assert_eq!(p["requested"]["roughness"], 0.2);
 
+    // A blend starts from the blend of both materials' attributes (roughness in log space).
+    let open = |id: &str| -> Value {
+        let (status, answer) = post(base, "/api/open", &json!({"material": id}).to_string());
+        assert_eq!(status, 200, "{}", text(&answer));
+        serde_json::from_slice(&answer).unwrap()
+    };
+    let (a, b) = (open("merl/red-plastic"), open("merl/chrome"));
+    let blend =
+        json!({"material": "merl/red-plastic", "blend": {"material": "merl/chrome", "t": 0.5}});
+    let (status, answer) = post(base, "/api/preview", &preview(blend));
+    assert_eq!(status, 200, "{}", text(&answer));
+    let blended: Value = serde_json::from_slice(&answer).unwrap();
+    let r = |v: &Value| v["roughness"].as_f64().unwrap();
+    let (ra, rb, rm) = (r(&a["attributes"]), r(&b["attributes"]), r(&blended["base"]));
+    assert!((rm - (ra * rb).sqrt()).abs() < 1e-9 * rm, "{ra} {rb} {rm}");
+    let d = |v: &Value| v["diffuse"][0].as_f64().unwrap();
+    let (da, db, dm) = (d(&a["attributes"]), d(&b["attributes"]), d(&blended["base"]));
+    assert!((dm - (da + db) / 2.0).abs() < 1e-9, "{da} {db} {dm}");
+
     let download = |format: &str, edit: &Value| {
         get(base, &format!("/api/download?format={format}&edit={}", encode(&edit.to_string())))
     };
