@@ -340,7 +340,7 @@ fn serve_page_edits_in_headless_chromium_and_downloads_a_merl_file() {
             json!({
                 "binary": chrome,
                 "args": ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-                         "--window-size=1200,880", "--hide-scrollbars"],
+                         "--window-size=1000,1010", "--hide-scrollbars"],
                 "prefs": {"download.default_directory": downloads,
                           "download.prompt_for_download": false},
             }),

@@ -17,7 +17,7 @@ use super::request::{
 use crate::editing::{self, ModelCodec, Space};
 use crate::latent_file::LatentFile;
 use deepbrdf_data::cache::Cache;
-use deepbrdf_data::dataset::load_material;
+use deepbrdf_data::dataset::load_bundled_material;
 use deepbrdf_data::merl::{merl_bytes, MerlFile};
 use deepbrdf_data::{MerlTable, Silent};
 use deepbrdf_eval::attributes::{Attributes, FitConfig};
@@ -418,7 +418,7 @@ impl Editor {
             ))
             .into());
         }
-        let (name, table) = load_material(id, &self.cache).map_err(internal)?;
+        let (name, table) = load_bundled_material(id, &self.cache).map_err(internal)?;
         self.open(id.to_string(), name, table)
     }
 
