@@ -195,6 +195,12 @@ fn serve_refuses_bad_input_with_4xx_and_keeps_running() {
     let opened: Value = serde_json::from_str(&answer).unwrap();
     let id = opened["id"].as_str().unwrap().to_string();
     assert!(id.starts_with("upload/") && opened["name"] == "synthetic", "{opened}");
+    // So does an RGL measurement, converted through the server's cache.
+    let bsdf = deepbrdf_data::rgl::bundled::bytes("paper_white_rgb").unwrap().to_vec();
+    let (status, answer) = upload("paper.bsdf", bsdf);
+    assert_eq!(status, 200, "{answer}");
+    let paper: Value = serde_json::from_str(&answer).unwrap();
+    assert!(paper["id"].as_str().unwrap().starts_with("upload/") && paper["name"] == "paper");
     let edit = json!({"material": id, "roughness": 0.2});
     let (status, answer) = post(base, "/api/preview", &preview(edit.clone()));
     assert_eq!(status, 200, "{}", text(&answer));
