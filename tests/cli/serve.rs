@@ -208,6 +208,19 @@ fn serve_refuses_bad_input_with_4xx_and_keeps_running() {
     assert!(p["image"].as_str().unwrap().starts_with("data:image/png;base64,"));
     assert_eq!(p["requested"]["roughness"], 0.2);
 
+    // Latest wins: a refined preview (8 render passes) still running when a newer preview
+    // arrives stops and is answered 409; the newer one is answered.
+    let refined = json!({"edit": {"material": m, "roughness": 0.3}, "quality": "refined"});
+    let (old, new) = std::thread::scope(|s| {
+        let old = s.spawn(|| post(base, "/api/preview", &refined.to_string()));
+        std::thread::sleep(Duration::from_millis(300));
+        let new = post(base, "/api/preview", &preview(json!({"material": m, "roughness": 0.31})));
+        (old.join().unwrap(), new)
+    });
+    assert_eq!(old.0, 409, "{}", text(&old.1));
+    assert!(text(&old.1).contains("superseded"), "{}", text(&old.1));
+    assert_eq!(new.0, 200, "{}", text(&new.1));
+
     // A blend starts from the blend of both materials' attributes (roughness in log space).
     let open = |id: &str| -> Value {
         let (status, answer) = post(base, "/api/open", &json!({"material": id}).to_string());
