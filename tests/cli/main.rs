@@ -13,5 +13,6 @@ mod model;
 mod recovery;
 mod reliability;
 mod render;
+mod serve;
 mod shipped;
 mod sweep_k;

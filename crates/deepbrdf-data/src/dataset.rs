@@ -194,8 +194,8 @@ fn is_file_spec(spec: &str) -> bool {
 /// `rgl/cardboard_rgb`, `rgl-measured/paper_white_rgb`). Returns the material's name and its
 /// table. Unknown names give an error listing close matches.
 pub fn load_material(spec: &str, cache: &Cache) -> Result<(String, MerlTable)> {
-    if let Some(name) = spec.strip_prefix("rgl-measured/") {
-        return Ok((name.to_string(), load_measured_material(name, cache)?));
+    if spec.starts_with("rgl-measured/") {
+        return load_bundled_material(spec, cache);
     }
     if spec.ends_with(".bsdf") {
         let path = Path::new(spec);
@@ -204,6 +204,16 @@ pub fn load_material(spec: &str, cache: &Cache) -> Result<(String, MerlTable)> {
     if is_file_spec(spec) {
         let path = Path::new(spec);
         return Ok((material_name(path), read_merl(path)?));
+    }
+    load_bundled_material(spec, cache)
+}
+
+/// Loads a bundled material by name only (`chrome`, `merl/chrome`,
+/// `rgl-measured/paper_white_rgb`): never a file, whatever the working directory holds (the
+/// browser editor's materials). Returns the material's name and its table.
+pub fn load_bundled_material(spec: &str, cache: &Cache) -> Result<(String, MerlTable)> {
+    if let Some(name) = spec.strip_prefix("rgl-measured/") {
+        return Ok((name.to_string(), load_measured_material(name, cache)?));
     }
     let (_, net) = find_material(spec)?;
     Ok((net.name().to_string(), cache.tabulated(net)?))

@@ -62,6 +62,28 @@ impl Image {
         self.rgb[y as usize * self.width as usize + x as usize]
     }
 
+    /// The pixel-wise mean of images of one size (renders of one scene with different seeds
+    /// average to a render with their samples pooled).
+    pub fn mean(images: &[Image]) -> Result<Image> {
+        let first =
+            images.first().ok_or_else(|| RenderError::Invalid("no images to average".into()))?;
+        let (w, h) = (first.width, first.height);
+        if images.iter().any(|i| i.width != w || i.height != h) {
+            return Err(RenderError::Invalid("images to average differ in size".into()));
+        }
+        let scale = 1.0 / images.len() as f32;
+        let mut mean = Image::black(w, h);
+        for image in images {
+            for (m, p) in mean.rgb.iter_mut().zip(&image.rgb) {
+                (0..3).for_each(|c| m[c] += p[c] * scale);
+            }
+            for (m, c) in mean.coverage.iter_mut().zip(&image.coverage) {
+                *m += c * scale;
+            }
+        }
+        Ok(mean)
+    }
+
     pub(crate) fn buffers_mut(&mut self) -> (&mut [[f32; 3]], &mut [f32]) {
         (&mut self.rgb, &mut self.coverage)
     }
@@ -251,12 +273,18 @@ impl Srgb8Image {
 
     /// Encodes as PNG and writes it atomically.
     pub fn write_png(&self, path: &Path) -> Result<()> {
+        let png = self.png_bytes().map_err(|e| RenderError::format(path, e.to_string()))?;
+        Ok(deepbrdf_data::files::write_atomic(path, &png)?)
+    }
+
+    /// The PNG encoding of the image.
+    pub fn png_bytes(&self) -> Result<Vec<u8>> {
         let img = image::RgbImage::from_raw(self.width, self.height, self.data.clone())
             .ok_or_else(|| RenderError::Invalid("image buffer has the wrong size".into()))?;
         let mut png = Vec::new();
         img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-            .map_err(|e| RenderError::format(path, format!("cannot encode PNG: {e}")))?;
-        Ok(deepbrdf_data::files::write_atomic(path, &png)?)
+            .map_err(|e| RenderError::Invalid(format!("cannot encode PNG: {e}")))?;
+        Ok(png)
     }
 }
 

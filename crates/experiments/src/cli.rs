@@ -83,6 +83,9 @@ pub enum Command {
     Interpolate(commands::interpolate::Args),
     /// The editing figures (Figs. 10, 12, 13, 14) and the measured edit suite.
     FiguresEditing(commands::figures_editing::Args),
+    /// The browser material editor: sliders for the 7 attributes and a blend, a live preview,
+    /// downloads of the edited .binary and latent (http://127.0.0.1:7878/ by default).
+    Serve(commands::serve::Args),
 }
 
 fn parse_device(s: &str) -> Result<deepbrdf_model::DeviceKind, String> {

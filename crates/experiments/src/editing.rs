@@ -3,6 +3,7 @@
 //! One home for what `edit`, `interpolate`, `figures-editing` and `bench edit` share: the
 //! paper's edit `Y' = Phi(alpha')`, the residual edit `Y' = Y + Phi(alpha') - Phi(alpha)`, the
 //! latent blend, and where a model's regressors live.
+use crate::model_arg::ModelArg;
 use anyhow::{bail, Context};
 use deepbrdf_data::MerlTable;
 use deepbrdf_eval::attributes::{self, Attributes, FitConfig};
@@ -14,6 +15,17 @@ use deepbrdf_model::regressor::{Regressor, TargetKind};
 use deepbrdf_model::DeepBrdf;
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
+
+/// The options naming what the editing commands (`edit`, `figures-editing`, `serve`, `bench
+/// edit`, `bench serve`) edit with: the model (`--model DIR`) and its regressor.
+#[derive(Debug, Clone, clap::Args)]
+pub struct EditorArg {
+    #[command(flatten)]
+    pub model: ModelArg,
+    /// The regressor folder [default: <model>/regressor].
+    #[arg(long, value_name = "DIR")]
+    pub regressor: Option<PathBuf>,
+}
 
 /// Name of the folder holding a model's regressors, inside the model directory.
 pub const REGRESSOR_DIR: &str = "regressor";
@@ -91,16 +103,28 @@ impl Space<'_> {
         mode: EditMode,
     ) -> anyhow::Result<Edited> {
         let requested = edit.apply(original)?;
-        let target = self.latent_of(&requested)?;
-        let latent = match mode {
+        let latent = self.edited_latent(latent, original, &requested, mode)?;
+        let table = self.codec.decode(&latent)?;
+        Ok(Edited { requested, table })
+    }
+
+    /// The latent of the edit from `original` (latent `latent`, used by the residual edit) to
+    /// the attributes `requested` (checked by [`Edit::apply`]), before decoding.
+    pub fn edited_latent(
+        &self,
+        latent: &[f32],
+        original: &Attributes,
+        requested: &Attributes,
+        mode: EditMode,
+    ) -> anyhow::Result<Vec<f32>> {
+        let target = self.latent_of(requested)?;
+        Ok(match mode {
             EditMode::Paper => target,
             EditMode::Residual => {
                 let base = self.latent_of(original)?;
                 latent.iter().zip(target.iter().zip(&base)).map(|(y, (t, b))| y + t - b).collect()
             }
-        };
-        let table = self.codec.decode(&latent)?;
-        Ok(Edited { requested, table })
+        })
     }
 }
 

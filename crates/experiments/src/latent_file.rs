@@ -19,9 +19,13 @@ impl LatentFile {
 
     /// Writes the file atomically ([`deepbrdf_data::files::write_atomic`]).
     pub fn save(&self, path: &Path) -> anyhow::Result<()> {
-        let text = serde_json::to_string_pretty(self)?;
-        deepbrdf_data::files::write_atomic(path, (text + "\n").as_bytes())?;
+        deepbrdf_data::files::write_atomic(path, &self.to_bytes()?)?;
         Ok(())
+    }
+
+    /// The file's content, as [`save`](Self::save) writes it (for a download, say).
+    pub fn to_bytes(&self) -> anyhow::Result<Vec<u8>> {
+        Ok((serde_json::to_string_pretty(self)? + "\n").into_bytes())
     }
 
     /// Reads and checks a latent file (at most 1 MB; k must match the values; all finite).

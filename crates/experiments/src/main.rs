@@ -16,6 +16,7 @@ mod readme_block;
 mod recovery_inputs;
 mod robustness;
 mod scene_args;
+mod serve;
 mod slices_figure;
 mod warnings;
 

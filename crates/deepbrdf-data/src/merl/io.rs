@@ -124,11 +124,13 @@ pub fn read_merl(path: impl AsRef<Path>) -> Result<MerlTable> {
 /// as [`INVALID_STORED`]; reading the file back gives a bit-identical table when the table's
 /// invalid values are [`INVALID_VALUE`] (as in every table this crate reads or builds).
 pub fn write_merl(table: &MerlTable, path: impl AsRef<Path>) -> Result<()> {
-    let values = table.values();
-    write_atomic(
-        path.as_ref(),
-        &encode(values.iter().enumerate().map(|(i, &v)| stored(i / CELLS, v))),
-    )
+    write_atomic(path.as_ref(), &merl_bytes(table))
+}
+
+/// The bytes of the MERL `.binary` file of a table ([`FILE_BYTES`] of them), as [`write_merl`]
+/// writes them (for a download, say).
+pub fn merl_bytes(table: &MerlTable) -> Vec<u8> {
+    encode(table.values().iter().enumerate().map(|(i, &v)| stored(i / CELLS, v)))
 }
 
 impl MerlTable {

@@ -7,5 +7,5 @@ pub mod lookup;
 pub mod table;
 
 pub use grid::{cell_coords, cell_index, CELLS, N_PHI_D, N_THETA_D, N_THETA_H, VALUES};
-pub use io::{read_merl, write_merl, MerlFile};
+pub use io::{merl_bytes, read_merl, write_merl, MerlFile};
 pub use table::{MerlTable, INVALID_VALUE, MERL_SCALE};

@@ -4,8 +4,7 @@
 //! roughness (§5.1) through the model's regressor (eq. 7) and decoder (eq. 3), writes the
 //! edited MERL table, and prints the attributes asked for and those re-estimated on the result.
 use crate::data_args::CacheArg;
-use crate::editing::{self, EditMode, ModelCodec, Space, DEFAULT_MODE};
-use crate::model_arg::ModelArg;
+use crate::editing::{self, EditMode, EditorArg, ModelCodec, Space, DEFAULT_MODE};
 use crate::scene_args::SceneArgs;
 use anyhow::{bail, Context};
 use deepbrdf_data::dataset::load_material;
@@ -20,10 +19,7 @@ use std::time::Instant;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(flatten)]
-    pub model: ModelArg,
-    /// The regressor folder [default: <model>/regressor].
-    #[arg(long, value_name = "DIR")]
-    pub regressor: Option<PathBuf>,
+    pub editor: EditorArg,
     /// A MERL .binary file or a bundled material.
     pub material: String,
     #[command(flatten)]
@@ -135,8 +131,9 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     // Checked before the model loads: a bad value fails at once.
     edit.apply(&original).with_context(|| format!("editing {name}"))?;
     let device = crate::device_arg::device()?;
-    let model_dir = args.model.dir()?;
-    let (model, regressor) = editing::load_editor(&model_dir, args.regressor.as_deref(), &device)?;
+    let model_dir = args.editor.model.dir()?;
+    let (model, regressor) =
+        editing::load_editor(&model_dir, args.editor.regressor.as_deref(), &device)?;
     let codec = ModelCodec(&model);
     let space = Space { codec: &codec, regressor: &regressor };
     let mode = args.mode.unwrap_or(DEFAULT_MODE);

@@ -19,8 +19,7 @@
 use super::interpolate::{self, Path3};
 use super::train_regressor::{self, IPCA_BASIS_FILE};
 use crate::data_args::DataArgs;
-use crate::editing::{self, ipca_owner_id, EditMode, ModelCodec, Space};
-use crate::model_arg::ModelArg;
+use crate::editing::{self, ipca_owner_id, EditMode, EditorArg, ModelCodec, Space};
 use anyhow::Context;
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::attributes::{Attributes, FitConfig};
@@ -39,10 +38,7 @@ use std::time::Instant;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(flatten)]
-    pub model: ModelArg,
-    /// The regressor folder [default: <model>/regressor].
-    #[arg(long, value_name = "DIR")]
-    pub regressor: Option<PathBuf>,
+    pub editor: EditorArg,
     /// Output folder.
     #[arg(long, value_name = "DIR", default_value = "results/editing")]
     pub out: PathBuf,
@@ -124,12 +120,12 @@ fn sweep(
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let started = Instant::now();
-    let model_dir = args.model.dir()?;
+    let model_dir = args.editor.model.dir()?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let device = crate::device_arg::device()?;
     let (model, deep_regressor) =
-        editing::load_editor(&model_dir, args.regressor.as_deref(), &device)?;
+        editing::load_editor(&model_dir, args.editor.regressor.as_deref(), &device)?;
     let k = model.k();
     let set = args.data.load(progress)?;
     let fit = FitConfig::default();
@@ -143,7 +139,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
 
     // IPCA at the same k, with its regressor (saved by `train-regressor --ipca`, else trained
     // here on the same materials).
-    let reg_dir = editing::regressor_dir(&model_dir, args.regressor.as_deref());
+    let reg_dir = editing::regressor_dir(&model_dir, args.editor.regressor.as_deref());
     let saved_basis = reg_dir.join(IPCA_BASIS_FILE);
     let basis = Arc::new(match saved_basis.exists() {
         true => BaselineBasis::load(&saved_basis)?,

@@ -21,6 +21,7 @@ pub mod reconstruct;
 pub mod recover;
 pub mod render;
 pub mod render_set;
+pub mod serve;
 pub mod sheet;
 pub mod sweep_k;
 pub mod tabulate;
@@ -47,6 +48,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Compare(args) => compare::run(args, &progress),
         Command::Convert(args) => convert::run(args, &progress),
         Command::Sheet(args) => sheet::run(args, &progress),
+        Command::Serve(args) => serve::run(args, &progress),
         Command::Baselines(args) => baselines::run(args, &progress),
         Command::Attributes(args) => attributes::run(args, &progress),
         Command::TrainRegressor(args) => train_regressor::run(args, &progress),

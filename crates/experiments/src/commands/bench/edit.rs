@@ -3,10 +3,10 @@
 //! edit), the decode (eq. 3) and a 128-pixel preview render (sphere, sun and sky, 16 spp); the
 //! attribute fit and the encode of the material, done once when it is picked, are timed apart.
 //! Without an edit option the edit is roughness x0.5.
+use super::median;
 use crate::commands::edit::EditArgs;
 use crate::data_args::CacheArg;
-use crate::editing::{self, EditMode, ModelCodec, Space, DEFAULT_MODE};
-use crate::model_arg::ModelArg;
+use crate::editing::{self, EditMode, EditorArg, ModelCodec, Space, DEFAULT_MODE};
 use anyhow::Context;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::{Progress, Silent};
@@ -15,16 +15,12 @@ use deepbrdf_eval::editing::{Edit, ScalarEdit};
 use deepbrdf_eval::harness::Codec;
 use deepbrdf_eval::metrics::ImageRelaeConfig;
 use deepbrdf_render::{render, MerlBrdf};
-use std::path::PathBuf;
 use std::time::Instant;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(flatten)]
-    pub model: ModelArg,
-    /// The regressor folder [default: <model>/regressor].
-    #[arg(long, value_name = "DIR")]
-    pub regressor: Option<PathBuf>,
+    pub editor: EditorArg,
     /// The material to edit.
     #[arg(default_value = "red-plastic")]
     pub material: String,
@@ -39,16 +35,12 @@ pub struct Args {
     pub cache: CacheArg,
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
 pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     let device = crate::device_arg::device()?;
-    let model_dir = args.model.dir()?;
+    let model_dir = args.editor.model.dir()?;
     let t = Instant::now();
-    let (model, regressor) = editing::load_editor(&model_dir, args.regressor.as_deref(), &device)?;
+    let (model, regressor) =
+        editing::load_editor(&model_dir, args.editor.regressor.as_deref(), &device)?;
     let load = t.elapsed().as_secs_f64();
     let (name, table) = load_material(&args.material, &args.cache.cache())
         .with_context(|| format!("loading material '{}'", args.material))?;
@@ -71,14 +63,7 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     for rep in 0..=args.reps.max(1) {
         let t0 = Instant::now();
         let requested = edit.apply(&original)?;
-        let target = space.latent_of(&requested)?;
-        let z: Vec<f32> = match mode {
-            EditMode::Paper => target,
-            EditMode::Residual => {
-                let base = space.latent_of(&original)?;
-                latent.iter().zip(target.iter().zip(&base)).map(|(y, (t, b))| y + t - b).collect()
-            }
-        };
+        let z = space.edited_latent(&latent, &original, &requested, mode)?;
         let t1 = Instant::now();
         let edited = codec.decode(&z)?;
         let t2 = Instant::now();

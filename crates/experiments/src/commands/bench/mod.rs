@@ -11,6 +11,7 @@ pub mod recover;
 pub mod render;
 pub mod render_noise;
 pub mod render_set;
+pub mod serve;
 pub mod tabulate;
 
 #[derive(Debug, clap::Args)]
@@ -44,9 +45,18 @@ pub enum What {
     RenderNoise(render_noise::Args),
     /// Images per second of the recovery render set (§5.2) at its CPU default.
     RenderSet(render_set::Args),
+    /// The browser editor over HTTP: preview latency and a burst of 20 slider moves (target:
+    /// a 128-px preview in <= 300 ms on 2 cores).
+    Serve(serve::Args),
     /// Seconds of one single-image recovery: prepare, network, decode (target: network +
     /// decode <= 0.5 s on 2 cores).
     Recover(recover::Args),
+}
+
+/// The median of timings (the upper one of an even count).
+pub fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
 }
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
@@ -61,5 +71,6 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         What::Edit(a) => edit::run(a, progress),
         What::RenderSet(a) => render_set::run(a, progress),
         What::Recover(a) => recover::run(a, progress),
+        What::Serve(a) => serve::run(a, progress),
     }
 }

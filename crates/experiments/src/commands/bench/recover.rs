@@ -1,6 +1,7 @@
 //! `experiments bench recover`: seconds of one `recover` (issue 12 target: network + decode at
 //! most 0.5 s on 2 cores): reading and preparing the photo, the recovery CNN, and DeepBRDF's
 //! decode of its latent (eq. 3), each the median of `--repeats` runs after a warm-up.
+use super::median;
 use crate::model_arg::ModelArg;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::{Progress, Silent};
@@ -22,11 +23,6 @@ pub struct Args {
     pub repeats: usize,
     #[command(flatten)]
     pub cache: crate::data_args::CacheArg,
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
