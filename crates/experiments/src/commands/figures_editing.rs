@@ -181,11 +181,25 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             .position(|n| n == name)
             .with_context(|| format!("{name} is not in {}", set.label))
     };
+    let trained = &model.provenance().materials;
+    let seen = set
+        .names
+        .iter()
+        .filter(|n| trained.iter().any(|t| *n == t || n.ends_with(&format!("/{t}"))))
+        .count();
+    let scope = if seen == set.len() {
+        "in-sample: the autoencoder was trained on every one of them".to_string()
+    } else if seen == 0 {
+        "held out: none of them was in the autoencoder's training set".to_string()
+    } else {
+        format!("{seen} of them were in the autoencoder's training set")
+    };
     let mut md = format!(
-        "# Editing (§5.1): figures and measured suite\n\nWritten by `experiments figures-editing` (model {}, k = {k}, {} materials of {}; in-sample: the autoencoder and both regressors were trained on every material).\n\n",
+        "# Editing (§5.1): figures and measured suite\n\nWritten by `experiments figures-editing` (model {}, k = {k}, {} materials of {}; {scope}; the regressors are those of `{}`, or trained here on these materials when missing).\n\n",
         model.id(),
         set.len(),
-        set.label
+        set.label,
+        reg_dir.display()
     );
 
     let mut sweeps_md = String::new();
