@@ -8,6 +8,7 @@ mod data;
 mod devices;
 mod editing;
 mod fetch_merl;
+mod generalize;
 mod kill;
 mod model;
 mod recovery;

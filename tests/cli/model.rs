@@ -6,11 +6,8 @@ use crate::util;
 use deepbrdf_data::merl::read_merl;
 use deepbrdf_model::burn::config::Config as _;
 use deepbrdf_model::{AutoencoderConfig, TrainConfig};
-use std::path::Path;
 
-fn s(p: &Path) -> String {
-    p.to_str().unwrap().to_string()
-}
+use crate::util::s;
 
 #[test]
 fn train_encode_decode_and_reconstruct_a_spectral_model() {

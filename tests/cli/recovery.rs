@@ -8,9 +8,7 @@ use deepbrdf_model::burn::config::Config as _;
 use deepbrdf_model::{AutoencoderConfig, TrainConfig};
 use std::path::Path;
 
-fn s(p: &Path) -> String {
-    p.to_str().unwrap().to_string()
-}
+use crate::util::s;
 
 #[test]
 fn render_set_train_recovery_and_recover_chain() {

@@ -26,9 +26,7 @@ fn in_namespace(script: &str) -> (bool, String, String) {
     )
 }
 
-fn s(p: &Path) -> String {
-    p.display().to_string()
-}
+use crate::util::s;
 
 #[test]
 fn a_second_run_on_a_locked_folder_is_refused_and_a_stale_lock_is_taken_over() {

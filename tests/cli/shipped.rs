@@ -5,9 +5,7 @@ use crate::util;
 use deepbrdf_data::merl::read_merl;
 use std::path::Path;
 
-fn s(p: &Path) -> String {
-    p.to_str().unwrap().to_string()
-}
+use crate::util::s;
 
 #[test]
 fn the_shipped_model_encodes_decodes_edits_and_recovers_without_model_options() {

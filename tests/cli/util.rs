@@ -5,6 +5,11 @@ use deepbrdf_data::merl::MerlTable;
 use std::path::Path;
 use std::process::{Command, Output};
 
+/// A path as a command-line argument.
+pub fn s(p: &Path) -> String {
+    p.display().to_string()
+}
+
 /// Runs `experiments` with `args` in `cwd` (quiet), returning its output.
 pub fn run_in(cwd: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_experiments"))

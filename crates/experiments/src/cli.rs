@@ -81,6 +81,9 @@ pub enum Command {
     /// Blend two materials in the DeepBRDF latent space, in IPCA coefficients and linearly
     /// (Fig. 10): renders and tables.
     Interpolate(commands::interpolate::Args),
+    /// Fig. 9: materials no representation was fitted to (default: the real RGL measurements),
+    /// as measured, as DeepBRDF and as IPCA reconstruct them, with the image RelAE of each.
+    FiguresGeneralize(commands::figures_generalize::Args),
     /// The editing figures (Figs. 10, 12, 13, 14) and the measured edit suite.
     FiguresEditing(commands::figures_editing::Args),
     /// The browser material editor: sliders for the 7 attributes and a blend, a live preview,

@@ -13,6 +13,7 @@ pub mod edit;
 pub mod encode;
 pub mod fetch_merl;
 pub mod figures_editing;
+pub mod figures_generalize;
 pub mod figures_recovery;
 pub mod info;
 pub mod interpolate;
@@ -55,6 +56,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Edit(args) => edit::run(args, &progress),
         Command::Interpolate(args) => interpolate::run(args, &progress),
         Command::FiguresEditing(args) => figures_editing::run(args, &progress),
+        Command::FiguresGeneralize(args) => figures_generalize::run(args, &progress),
         Command::RenderSet(args) => render_set::run(args, &progress),
         Command::TrainRecovery(args) => train_recovery::run(args, &progress),
         Command::Recover(args) => recover::run(args, &progress),

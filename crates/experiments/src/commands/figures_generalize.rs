@@ -1,0 +1,148 @@
+//! `experiments figures-generalize [--model DIR] [--collection rgl-measured | --data DIR]`:
+//! Fig. 9 of Hu et al. (2020) on materials no representation was fitted to (by default the
+//! seven real RGL measurements): each material rendered as measured, as DeepBRDF reconstructs it
+//! (eq. 2 then eq. 3) and as IPCA does at the model's k, IPCA fitted on the model's training
+//! data; the image RelAE of each reconstruction under its caption (the harness's measure,
+//! [`ImageRelae`]: the preview sphere, sun and sky).
+use crate::data_args::CacheArg;
+use crate::editing::ModelCodec;
+use crate::model_arg::ModelArg;
+use anyhow::{bail, Context};
+use deepbrdf_data::bundled::Collection;
+use deepbrdf_data::dataset::{DataSource, Dataset};
+use deepbrdf_data::files::write_atomic;
+use deepbrdf_data::Progress;
+use deepbrdf_eval::baseline::{BaselineBasis, MappingKind};
+use deepbrdf_eval::harness::Codec;
+use deepbrdf_eval::metrics::{relae, ImageRelae, ImageRelaeConfig};
+use deepbrdf_model::DeepBrdf;
+use deepbrdf_render::sheet::{contact_sheet, SheetConfig, Tile};
+use deepbrdf_render::Tonemap;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    pub model: ModelArg,
+    /// The materials to show: a bundled collection (default: the real RGL measurements).
+    #[arg(long, value_name = "NAME", default_value = "rgl-measured", conflicts_with = "data")]
+    pub collection: Collection,
+    /// A folder of MERL .binary files to show instead.
+    #[arg(long, value_name = "DIR")]
+    pub data: Option<PathBuf>,
+    /// Fit IPCA on this folder of MERL .binary files [default: the bundled `merl` collection,
+    /// which must be what the model was trained on].
+    #[arg(long, value_name = "DIR")]
+    pub ipca_data: Option<PathBuf>,
+    /// Output folder.
+    #[arg(long, value_name = "DIR", default_value = "results/fig9")]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub cache: CacheArg,
+}
+
+/// One material's row.
+struct Row {
+    material: String,
+    deepbrdf: f64,
+    ipca: f64,
+}
+
+pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
+    let device = crate::device_arg::device()?;
+    let model = DeepBrdf::load(&args.model.dir()?, &device)?;
+    let k = model.k();
+    let cache = args.cache.cache();
+    let train_source = match &args.ipca_data {
+        Some(dir) => DataSource::Folder(dir.clone()),
+        None => {
+            let label = &model.provenance().data_label;
+            if label != "merl" {
+                bail!(
+                    "the model was trained on '{label}', not the bundled merl collection: give \
+                     --ipca-data DIR with its training materials, so that IPCA is fitted on the \
+                     same data"
+                );
+            }
+            DataSource::Bundled(Collection::Merl)
+        }
+    };
+    let train = Dataset::load(&train_source, &cache, progress)
+        .with_context(|| format!("loading IPCA's training data {}", train_source.label()))?;
+    let refs: Vec<_> = train.tables.iter().collect();
+    let basis = Arc::new(BaselineBasis::fit("IPCA", MappingKind::LogRelative, &refs, k, progress)?);
+    let ipca = basis.codec(k)?;
+    let deep = ModelCodec(&model);
+    let source = match &args.data {
+        Some(dir) => DataSource::Folder(dir.clone()),
+        None => DataSource::Bundled(args.collection),
+    };
+    let shown = Dataset::load(&source, &cache, progress)
+        .with_context(|| format!("loading the dataset {}", source.label()))?;
+    let seen = shown.names.iter().filter(|n| train.names.contains(n)).count();
+    if seen > 0 {
+        eprintln!("note: {seen} of the shown materials are in IPCA's training data");
+    }
+
+    let tonemap = Tonemap::default();
+    let srgb = |img: &deepbrdf_render::Image| img.to_srgb8(&tonemap, [0, 0, 0]);
+    let (mut originals, mut deeps, mut ipcas, mut rows) = (vec![], vec![], vec![], vec![]);
+    progress.start(shown.len() as u64, "rendering");
+    for (name, table) in shown.names.iter().zip(&shown.tables) {
+        let measure = ImageRelae::new(table, &ImageRelaeConfig::default())?;
+        let short = name.rsplit('/').next().unwrap_or(name).to_string();
+        let mut row = Row { material: name.clone(), deepbrdf: 0.0, ipca: 0.0 };
+        for (label, codec, slot, out) in [
+            ("DeepBRDF", &deep as &dyn Codec, &mut row.deepbrdf, &mut deeps),
+            ("IPCA", &ipca as &dyn Codec, &mut row.ipca, &mut ipcas),
+        ] {
+            let reconstruction = codec.decode(&codec.encode(table)?)?;
+            let image = measure.render(&reconstruction)?;
+            *slot = relae(&image, measure.reference())?;
+            out.push(Tile { image: srgb(&image), caption: format!("{label}: RelAE {:.3}", *slot) });
+        }
+        originals.push(Tile { image: srgb(measure.reference()), caption: short });
+        rows.push(row);
+        progress.advance(1);
+    }
+    progress.finish();
+    let columns = rows.len() as u32;
+    let tiles: Vec<Tile> = originals.into_iter().chain(deeps).chain(ipcas).collect();
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    contact_sheet(&tiles, &SheetConfig { columns, ..Default::default() })?
+        .write_png(&args.out.join("fig9.png"))?;
+
+    let mut csv = String::from("material,relae_deepbrdf,relae_ipca\n");
+    let mut md = format!(
+        "Fig. 9 on {} ({} materials), written by `experiments figures-generalize`: DeepBRDF \
+         model {} (k = {k}, trained on {}) and IPCA at k = {k} fitted on {} ({} materials); \
+         image RelAE on the preview sphere under sun and sky (128 px, 16 spp).\n\n\
+         ![Fig. 9](fig9.png)\n\n| material | DeepBRDF | IPCA |\n| --- | ---: | ---: |\n",
+        shown.label,
+        shown.len(),
+        model.id(),
+        model.provenance().data_label,
+        train.label,
+        train.len()
+    );
+    for r in &rows {
+        writeln!(csv, "{},{:.6},{:.6}", r.material, r.deepbrdf, r.ipca)?;
+        writeln!(md, "| {} | {:.4} | {:.4} |", r.material, r.deepbrdf, r.ipca)?;
+    }
+    let n = rows.len().max(1) as f64;
+    let (d, i) = (
+        rows.iter().map(|r| r.deepbrdf).sum::<f64>() / n,
+        rows.iter().map(|r| r.ipca).sum::<f64>() / n,
+    );
+    let wins = rows.iter().filter(|r| r.deepbrdf < r.ipca).count();
+    writeln!(md, "| **mean** | **{d:.4}** | **{i:.4}** |")?;
+    writeln!(md, "\nDeepBRDF is below IPCA on {wins} of {} materials.", rows.len())?;
+    write_atomic(&args.out.join("fig9.csv"), csv.as_bytes())?;
+    write_atomic(&args.out.join("summary.md"), md.as_bytes())?;
+    print!("{md}");
+    eprintln!("wrote {}/fig9.png, fig9.csv, summary.md", args.out.display());
+    Ok(())
+}

@@ -1,0 +1,47 @@
+//! `figures-generalize` (Fig. 9) on tiny data: a model and IPCA fitted on three synthetic
+//! materials, shown on two others; a model of other data without `--ipca-data` is refused.
+use crate::util;
+use crate::util::s;
+use deepbrdf_model::burn::config::Config as _;
+use deepbrdf_model::{AutoencoderConfig, TrainConfig};
+
+#[test]
+fn figures_generalize_writes_fig9_with_both_methods_relae() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = util::write_data(dir.path(), 3);
+    let shown = dir.path().join("shown");
+    std::fs::create_dir(&shown).unwrap();
+    for i in [3, 4] {
+        deepbrdf_data::merl::write_merl(&util::material(i), shown.join(format!("n{i}.binary")))
+            .unwrap();
+    }
+    let mut config = TrainConfig::cpu(2).with_epochs(2).with_batch_size(2);
+    config.model = AutoencoderConfig::spectral(2, 3, Some(8));
+    let config_path = dir.path().join("tiny.json");
+    config.save(&config_path).unwrap();
+    let model = dir.path().join("model");
+    let o = util::run_in(
+        dir.path(),
+        &["train", "--config", &s(&config_path), "--data", &s(&data), "--out", &s(&model)],
+    );
+    assert!(o.status.success(), "{}", util::stderr(&o));
+
+    let out = dir.path().join("fig9");
+    let args = ["figures-generalize", "--model", &s(&model), "--data", &s(&shown)];
+    let refused = util::run_in(dir.path(), &args);
+    util::assert_clean_failure(&refused, "--ipca-data");
+    let o = util::run_in(
+        dir.path(),
+        &[&args[..], &["--ipca-data", &s(&data), "--out", &s(&out)]].concat(),
+    );
+    assert!(o.status.success(), "{}", util::stderr(&o));
+    let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    let csv = std::fs::read_to_string(out.join("fig9.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 3, "{csv}");
+    for line in csv.lines().skip(1) {
+        let v: Vec<f64> = line.split(',').skip(1).map(|x| x.parse().unwrap()).collect();
+        assert!(v.iter().all(|x| x.is_finite() && *x > 0.0), "{line}");
+    }
+    assert!(summary.contains("| n3 |") && summary.contains("**mean**"), "{summary}");
+    assert!(out.join("fig9.png").is_file());
+}
