@@ -296,6 +296,35 @@ mod tests {
     }
 
     #[test]
+    fn mutated_requests_are_checked_or_refused_never_a_panic() {
+        use deepbrdf_data::testing::mutate::{fuzz, inputs, Focus};
+        let c = catalogue();
+        let preview = br#"{"edit":{"material":"merl/chrome","blend":{"material":"rgl-measured/paper_white_rgb","t":0.25},"diffuse":[0.2,0.1,0.05],"specular":[0.04,0.04,0.04],"roughness":0.1,"mode":"paper","scene":{"shape":"torus","sun_elevation":35.0,"sun_azimuth":-20.0,"turbidity":4.0}},"quality":"fast","sequence":7}"#;
+        let plain = br#"{"edit":{"material":"merl/chrome"},"quality":"refined"}"#;
+        let corpus = vec![preview.to_vec(), plain.to_vec(), b"red-plastic (2).binary".to_vec()];
+        for seed in &corpus[..2] {
+            let r: PreviewRequest = serde_json::from_slice(seed).unwrap();
+            r.edit.check(&c).unwrap();
+        }
+        let n = inputs(20_000);
+        let report = fuzz(&corpus, 2028, n, Focus { header: 48, header_share: 0.3 }, |b| {
+            let _ = check_upload_name(&String::from_utf8_lossy(b));
+            let request: PreviewRequest =
+                serde_json::from_slice(b).map_err(|e| bad(e.to_string()))?;
+            let checked = request.edit.check(&c)?;
+            // What passes the check is what the editor may use.
+            assert!(c.is_bundled(&checked.material), "{}", checked.material);
+            if let Some((m, t)) = &checked.blend {
+                assert!(c.is_bundled(m) && (0.0..=1.0).contains(t), "{m} {t}");
+            }
+            Ok::<_, Refusal>(checked)
+        });
+        eprintln!("editor requests: {report:?}");
+        assert!(report.panics.is_empty(), "panics: {:?}", report.panics);
+        assert!(report.accepted > 0 && report.rejected > 0, "{report:?}");
+    }
+
+    #[test]
     fn ids_are_names_never_paths() {
         let c = catalogue();
         assert!(c.check("merl/chrome").is_ok());
