@@ -111,11 +111,39 @@ fn sweep_k_writes_results_and_reuses_trained_models() {
 }
 
 #[test]
+fn sweep_k_in_generalize_mode_scores_another_collection() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = util::write_data(dir.path(), 3);
+    let config = dir.path().join("tiny.json");
+    tiny_config(&config);
+    let out = dir.path().join("out");
+    let cache = dir.path().join("cache");
+    let args = sweep_args(
+        &data,
+        &config,
+        &out,
+        &["--mode", "generalize", "--eval-collections", "nielsen2015", "--measures"],
+    );
+    let mut args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let cache = cache.to_str().unwrap();
+    args.extend(["mapped_mse", "--fig2-ks", "2", "--cache", cache]);
+    let o = util::run_in(dir.path(), &args);
+    assert!(o.status.success(), "{}", util::stderr(&o));
+    let results = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    // 3 methods x 2 k x the 8 nielsen2015 materials, one measure; none of the training ones.
+    assert_eq!(results.lines().count(), 1 + 3 * 2 * 8, "{results}");
+    assert!(results.contains(",bluebook,") && !results.contains(",m1,"), "{results}");
+    let robustness = std::fs::read_to_string(out.join("robustness.csv")).unwrap();
+    // Per material: DeepBRDF from all slices (k = 2), and per reduced input the fill and k = 2.
+    assert_eq!(robustness.lines().count(), 1 + 8 * (1 + 2 * 2), "{robustness}");
+}
+
+#[test]
 fn sweep_k_refuses_bad_settings_cleanly() {
     let out = util::run(&["sweep-k", "--ks", "0,5"]);
     util::assert_clean_failure(&out, "k values");
-    let out = util::run(&["sweep-k", "--mode", "generalize"]);
-    util::assert_clean_failure(&out, "in-sample or kfold");
+    let out = util::run(&["sweep-k", "--eval-collections", "nielsen2015"]);
+    util::assert_clean_failure(&out, "generalize mode only");
     let out = util::run(&["sweep-k", "--data", "/nonexistent/folder", "--epochs", "1"]);
     util::assert_clean_failure(&out, "/nonexistent/folder");
 }

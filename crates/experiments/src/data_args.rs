@@ -69,3 +69,33 @@ impl DataArgs {
             .with_context(|| format!("loading the dataset {}", source.label()))
     }
 }
+
+/// Loads bundled `collections` (through the cache of `data`) as one evaluation set. Names are
+/// kept as they are unless two collections share one, which is then prefixed `collection/`.
+pub fn load_collections(
+    collections: &[Collection],
+    data: &DataArgs,
+    progress: &dyn Progress,
+) -> anyhow::Result<Dataset> {
+    if collections.is_empty() {
+        anyhow::bail!("generalize mode needs at least one evaluation collection");
+    }
+    let cache = cache_at(data.cache.dir.as_deref());
+    let mut sets = Vec::new();
+    for &c in collections {
+        let set = Dataset::load(&DataSource::Bundled(c), &cache, progress)
+            .with_context(|| format!("loading the evaluation collection {c}"))?;
+        sets.push((c, set));
+    }
+    let mut names: Vec<String> = Vec::new();
+    let mut tables = Vec::new();
+    for (c, set) in &sets {
+        for (name, table) in set.names.iter().zip(&set.tables) {
+            let clash = sets.iter().any(|(o, s)| o != c && s.names.contains(name));
+            names.push(if clash { format!("{c}/{name}") } else { name.clone() });
+            tables.push(table.clone());
+        }
+    }
+    let label = collections.iter().map(|c| c.name()).collect::<Vec<_>>().join(" + ");
+    Ok(Dataset { label, names, tables })
+}

@@ -1,11 +1,10 @@
 //! `experiments baselines`: the PCA and IPCA baselines of §4 (Hu et al. 2020) through the
 //! evaluation harness: fit, encode/decode every material at each k, measure, print the summary
 //! table and write the results folder (CSV, markdown, Fig. 3 / Fig. 7 style plots).
-use crate::data_args::{cache_at, DataArgs};
+use crate::data_args::DataArgs;
 use crate::deep_method::DeepMethod;
 use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
-use deepbrdf_data::dataset::{DataSource, Dataset};
 use deepbrdf_data::Progress;
 use deepbrdf_eval::attributes::AttributeMethod;
 use deepbrdf_eval::baseline::BaselineMethod;
@@ -116,7 +115,8 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     );
     let eval = if args.mode == Mode::Generalize {
         let t = Instant::now();
-        let eval = load_collections(&args.eval_collections, &args.data, progress)?;
+        let eval =
+            crate::data_args::load_collections(&args.eval_collections, &args.data, progress)?;
         eprintln!(
             "loaded {} ({} materials) in {:.1} s",
             eval.label,
@@ -189,36 +189,6 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
 
 fn default_eval_collections() -> Vec<Collection> {
     vec![Collection::Nielsen2015, Collection::Rgl]
-}
-
-/// Loads bundled `collections` (through the cache of `data`) as one evaluation set. Names are
-/// kept as they are unless two collections share one, which is then prefixed `collection/`.
-fn load_collections(
-    collections: &[Collection],
-    data: &DataArgs,
-    progress: &dyn Progress,
-) -> anyhow::Result<Dataset> {
-    if collections.is_empty() {
-        bail!("generalize mode needs at least one evaluation collection");
-    }
-    let cache = cache_at(data.cache.dir.as_deref());
-    let mut sets = Vec::new();
-    for &c in collections {
-        let set = Dataset::load(&DataSource::Bundled(c), &cache, progress)
-            .with_context(|| format!("loading the evaluation collection {c}"))?;
-        sets.push((c, set));
-    }
-    let mut names: Vec<String> = Vec::new();
-    let mut tables = Vec::new();
-    for (c, set) in &sets {
-        for (name, table) in set.names.iter().zip(&set.tables) {
-            let clash = sets.iter().any(|(o, s)| o != c && s.names.contains(name));
-            names.push(if clash { format!("{c}/{name}") } else { name.clone() });
-            tables.push(table.clone());
-        }
-    }
-    let label = collections.iter().map(|c| c.name()).collect::<Vec<_>>().join(" + ");
-    Ok(Dataset { label, names, tables })
 }
 
 /// Fails when `dir` already holds one of `files`, unless `force`.

@@ -13,6 +13,7 @@ use crate::readme_block;
 use crate::robustness::{self, Robustness, NEAREST_FILL};
 use crate::slices_figure::{self, FIG2_MATERIAL};
 use anyhow::{bail, Context};
+use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::dataset::Dataset;
 use deepbrdf_data::files::write_atomic;
 use deepbrdf_data::Progress;
@@ -42,10 +43,15 @@ pub struct Args {
     /// Override the number of training epochs.
     #[arg(long, value_name = "N")]
     pub epochs: Option<usize>,
-    /// `in-sample` (fit and evaluate on all materials, the paper's Fig. 3) or `kfold:N`
-    /// (each material evaluated by models that never saw it).
+    /// `in-sample` (fit and evaluate on all materials, the paper's Fig. 3), `kfold:N` (each
+    /// material evaluated by models that never saw it) or `generalize` (fit on the data,
+    /// evaluate on --eval-collections: Fig. 9).
     #[arg(long, default_value = "in-sample")]
     pub mode: Mode,
+    /// Generalize mode: the bundled collections to evaluate on (comma-separated) [default:
+    /// rgl-measured, the real measurements].
+    #[arg(long, value_delimiter = ',', value_name = "NAME,...")]
+    pub eval_collections: Option<Vec<Collection>>,
     /// Output folder [default: results/sweep-k, or results/sweep-k-kfoldN in k-fold mode].
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
@@ -126,6 +132,7 @@ impl Args {
     fn out_dir(&self) -> PathBuf {
         self.out.clone().unwrap_or_else(|| match self.mode {
             Mode::KFold { folds } => PathBuf::from(format!("results/sweep-k-kfold{folds}")),
+            Mode::Generalize => PathBuf::from("results/sweep-k-generalize"),
             _ => PathBuf::from("results/sweep-k"),
         })
     }
@@ -148,8 +155,8 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
     let started = Instant::now();
     let logged = ProgressLog::new(bars, quiet, Duration::from_secs(30));
     let progress: &dyn Progress = &logged;
-    if args.mode == Mode::Generalize {
-        bail!("sweep-k runs in-sample or kfold:N, not generalize");
+    if args.mode != Mode::Generalize && args.eval_collections.is_some() {
+        bail!("--eval-collections is for generalize mode only");
     }
     let harness_config = HarnessConfig {
         ks: args.ks.clone(),
@@ -168,6 +175,14 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
     let models_dir = out.join("models");
 
     let data = args.load_data(progress)?;
+    let eval = match args.mode {
+        Mode::Generalize => {
+            let collections =
+                args.eval_collections.clone().unwrap_or_else(|| vec![Collection::RglMeasured]);
+            Some(crate::data_args::load_collections(&collections, &args.data, progress)?)
+        }
+        _ => None,
+    };
     let loaded_at = started.elapsed().as_secs_f64();
     let sample = config_for(args.ks[0]);
     let training = match &args.train_config {
@@ -197,13 +212,22 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
     let deep =
         DeepMethod::new(config_for, &models_dir, &data.label, device.clone()).retaining(&retained);
     let materials = Materials { names: &data.names, tables: &data.tables, label: &data.label };
-    let results = harness::run(&[&pca, &ipca, &deep], &harness_config, materials, None, progress)?;
+    let eval_label = eval.as_ref().map(|e| format!("{} ({} materials)", e.label, e.len()));
+    let eval_materials = eval.as_ref().zip(eval_label.as_deref()).map(|(e, label)| Materials {
+        names: &e.names,
+        tables: &e.tables,
+        label,
+    });
+    let results =
+        harness::run(&[&pca, &ipca, &deep], &harness_config, materials, eval_materials, progress)?;
     results.write(&out)?;
 
-    let folds = args.mode.folds(data.names.len(), data.names.len(), args.seed)?;
+    // Fig. 2's reduced inputs, on the materials each fold's models are scored on.
+    let scored = eval.as_ref().unwrap_or(&data);
+    let folds = args.mode.folds(data.names.len(), scored.names.len(), args.seed)?;
     let robustness = robustness::measure(
-        &data.names,
-        &data.tables,
+        &scored.names,
+        &scored.tables,
         &folds,
         &deep,
         &fig2_ks,
@@ -212,7 +236,7 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
     )?;
     robustness.write(&out)?;
 
-    let fig2 = fig2_picture(&args, &data, &folds, &deep, &out)?;
+    let fig2 = fig2_picture(&args, scored, &folds, &deep, &out)?;
     let fits = deep.fits();
     write_training_csv(&fits, &out)?;
 
