@@ -506,9 +506,7 @@ fn per_material_chart(rows: &[Row], set: &str, stem: &std::path::Path) -> anyhow
         })
         .collect();
     let chart = LineChart {
-        title: format!(
-            "recovery, {set}: novel-scene image RelAE per material (mean over its images)"
-        ),
+        title: format!("recovery, {set}: image RelAE per material, novel scenes"),
         x_label: "material".into(),
         y_label: "image RelAE".into(),
         log_y: true,
