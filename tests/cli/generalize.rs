@@ -2,8 +2,6 @@
 //! materials, shown on two others; a model of other data without `--ipca-data` is refused.
 use crate::util;
 use crate::util::s;
-use deepbrdf_model::burn::config::Config as _;
-use deepbrdf_model::{AutoencoderConfig, TrainConfig};
 
 #[test]
 fn figures_generalize_writes_fig9_with_both_methods_relae() {
@@ -15,10 +13,7 @@ fn figures_generalize_writes_fig9_with_both_methods_relae() {
         deepbrdf_data::merl::write_merl(&util::material(i), shown.join(format!("n{i}.binary")))
             .unwrap();
     }
-    let mut config = TrainConfig::cpu(2).with_epochs(2).with_batch_size(2);
-    config.model = AutoencoderConfig::spectral(2, 3, Some(8));
-    let config_path = dir.path().join("tiny.json");
-    config.save(&config_path).unwrap();
+    let config_path = util::tiny_config(dir.path());
     let model = dir.path().join("model");
     let o = util::run_in(
         dir.path(),

@@ -4,8 +4,6 @@
 //! refusal of a network trained for another model.
 use crate::util;
 use deepbrdf_data::merl::read_merl;
-use deepbrdf_model::burn::config::Config as _;
-use deepbrdf_model::{AutoencoderConfig, TrainConfig};
 use std::path::Path;
 
 use crate::util::s;
@@ -20,10 +18,7 @@ fn render_set_train_recovery_and_recover_chain() {
         out
     };
     // A tiny spectral model (k = 2) on the three materials.
-    let mut config = TrainConfig::cpu(2).with_epochs(2).with_batch_size(2);
-    config.model = AutoencoderConfig::spectral(2, 3, Some(8));
-    let config_path = dir.path().join("tiny.json");
-    config.save(&config_path).unwrap();
+    let config_path = util::tiny_config(dir.path());
     let model = dir.path().join("model");
     ok(&["train", "--config", &s(&config_path), "--data", &s(&data), "--out", &s(&model)]);
 

@@ -10,6 +10,17 @@ pub fn s(p: &Path) -> String {
     p.display().to_string()
 }
 
+/// Writes the training configuration of a tiny spectral model (k = 2, 2 epochs, batches of 2:
+/// seconds on three synthetic materials) to `dir/tiny.json` and returns its path.
+pub fn tiny_config(dir: &Path) -> std::path::PathBuf {
+    use deepbrdf_model::burn::config::Config as _;
+    let mut config = deepbrdf_model::TrainConfig::cpu(2).with_epochs(2).with_batch_size(2);
+    config.model = deepbrdf_model::AutoencoderConfig::spectral(2, 3, Some(8));
+    let path = dir.join("tiny.json");
+    config.save(&path).expect("writing the training configuration");
+    path
+}
+
 /// Runs `experiments` with `args` in `cwd` (quiet), returning its output.
 pub fn run_in(cwd: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_experiments"))
