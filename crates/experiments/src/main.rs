@@ -18,6 +18,7 @@ mod robustness;
 mod scene_args;
 mod serve;
 mod slices_figure;
+mod stats;
 mod warnings;
 
 use clap::Parser;

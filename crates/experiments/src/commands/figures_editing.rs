@@ -20,6 +20,7 @@ use super::interpolate::{self, Path3};
 use super::train_regressor::{self, IPCA_BASIS_FILE};
 use crate::data_args::DataArgs;
 use crate::editing::{self, ipca_owner_id, EditMode, EditorArg, ModelCodec, Space};
+use crate::stats::{mean, median};
 use anyhow::Context;
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::attributes::{Attributes, FitConfig};
@@ -90,20 +91,6 @@ struct SuiteRow {
 struct Rep<'a> {
     name: &'static str,
     space: Space<'a>,
-}
-
-fn mean(v: impl Iterator<Item = f64>) -> f64 {
-    let v: Vec<f64> = v.filter(|x| x.is_finite()).collect();
-    match v.is_empty() {
-        true => f64::NAN,
-        false => v.iter().sum::<f64>() / v.len() as f64,
-    }
-}
-
-fn median(v: impl Iterator<Item = f64>) -> f64 {
-    let mut v: Vec<f64> = v.filter(|x| x.is_finite()).collect();
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
 /// A sweep of `edits` on one material for one representation and mode: its tables.

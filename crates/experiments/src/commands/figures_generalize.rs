@@ -7,6 +7,7 @@
 use crate::data_args::CacheArg;
 use crate::editing::ModelCodec;
 use crate::model_arg::ModelArg;
+use crate::stats::mean;
 use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::dataset::{DataSource, Dataset};
@@ -132,11 +133,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         writeln!(csv, "{},{:.6},{:.6}", r.material, r.deepbrdf, r.ipca)?;
         writeln!(md, "| {} | {:.4} | {:.4} |", r.material, r.deepbrdf, r.ipca)?;
     }
-    let n = rows.len().max(1) as f64;
-    let (d, i) = (
-        rows.iter().map(|r| r.deepbrdf).sum::<f64>() / n,
-        rows.iter().map(|r| r.ipca).sum::<f64>() / n,
-    );
+    let (d, i) = (mean(rows.iter().map(|r| r.deepbrdf)), mean(rows.iter().map(|r| r.ipca)));
     let wins = rows.iter().filter(|r| r.deepbrdf < r.ipca).count();
     writeln!(md, "| **mean** | **{d:.4}** | **{i:.4}** |")?;
     writeln!(md, "\nDeepBRDF is below IPCA on {wins} of {} materials.", rows.len())?;

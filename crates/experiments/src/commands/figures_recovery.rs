@@ -15,6 +15,7 @@
 use crate::data_args::CacheArg;
 use crate::model_arg::ModelArg;
 use crate::recovery_inputs::{attributes_of, load_tables, set_images};
+use crate::stats::{mean, median};
 use anyhow::{bail, Context};
 use deepbrdf_data::merl::{CELLS, INVALID_VALUE, VALUES};
 use deepbrdf_data::{MerlTable, Progress, Silent};
@@ -341,21 +342,6 @@ fn nearest_materials(
         bail!("image {}: no training material renders to a usable image in its scene", indices[i]);
     }
     Ok(best.into_iter().map(|b| b.1).collect())
-}
-
-fn mean(v: impl Iterator<Item = f64>) -> f64 {
-    let v: Vec<f64> = v.collect();
-    v.iter().sum::<f64>() / v.len().max(1) as f64
-}
-
-fn median(v: impl Iterator<Item = f64>) -> f64 {
-    let mut v: Vec<f64> = v.collect();
-    v.sort_by(f64::total_cmp);
-    if v.is_empty() {
-        f64::NAN
-    } else {
-        v[v.len() / 2]
-    }
 }
 
 #[allow(clippy::too_many_arguments)]

@@ -3,10 +3,10 @@
 //! edit), the decode (eq. 3) and a 128-pixel preview render (sphere, sun and sky, 16 spp); the
 //! attribute fit and the encode of the material, done once when it is picked, are timed apart.
 //! Without an edit option the edit is roughness x0.5.
-use super::median;
 use crate::commands::edit::EditArgs;
 use crate::data_args::CacheArg;
 use crate::editing::{self, EditMode, EditorArg, ModelCodec, Space, DEFAULT_MODE};
+use crate::stats::median;
 use anyhow::Context;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::{Progress, Silent};

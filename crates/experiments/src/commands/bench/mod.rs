@@ -53,12 +53,6 @@ pub enum What {
     Recover(recover::Args),
 }
 
-/// The median of timings (the upper one of an even count).
-pub fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     match args.what {
         What::Io(a) => io::run(a, progress),

@@ -1,8 +1,8 @@
 //! `experiments bench recover`: seconds of one `recover` (issue 12 target: network + decode at
 //! most 0.5 s on 2 cores): reading and preparing the photo, the recovery CNN, and DeepBRDF's
 //! decode of its latent (eq. 3), each the median of `--repeats` runs after a warm-up.
-use super::median;
 use crate::model_arg::ModelArg;
+use crate::stats::median;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::{Progress, Silent};
 use deepbrdf_model::DeepBrdf;
