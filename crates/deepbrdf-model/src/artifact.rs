@@ -69,6 +69,12 @@ pub struct Provenance {
 }
 
 impl Provenance {
+    /// Whether the material `name` (as the training data named it, or `collection/name` as a
+    /// bundled material is named) is one of the training BRDFs.
+    pub fn trained_on(&self, name: &str) -> bool {
+        self.materials.iter().any(|t| name == t || name.ends_with(&format!("/{t}")))
+    }
+
     /// The provenance of a network that was not trained on data (synthetic weights for tests and
     /// benchmarks), labelled `label`.
     pub fn untrained(label: &str, seed: u64) -> Self {

@@ -168,12 +168,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             .position(|n| n == name)
             .with_context(|| format!("{name} is not in {}", set.label))
     };
-    let trained = &model.provenance().materials;
-    let seen = set
-        .names
-        .iter()
-        .filter(|n| trained.iter().any(|t| *n == t || n.ends_with(&format!("/{t}"))))
-        .count();
+    let seen = set.names.iter().filter(|n| model.provenance().trained_on(n)).count();
     let scope = if seen == set.len() {
         "in-sample: the autoencoder was trained on every one of them".to_string()
     } else if seen == 0 {

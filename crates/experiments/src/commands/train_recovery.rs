@@ -65,12 +65,8 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         "latent" => {
             let dir = args.model.dir()?;
             let model = DeepBrdf::load(&dir, &device)?;
-            let seen: Vec<&String> = set
-                .header
-                .excluded
-                .iter()
-                .filter(|m| model.provenance().materials.iter().any(|t| m.ends_with(t.as_str())))
-                .collect();
+            let seen: Vec<&String> =
+                set.header.excluded.iter().filter(|m| model.provenance().trained_on(m)).collect();
             if !seen.is_empty() {
                 eprintln!(
                     "note: the model was trained on {} of the materials this set leaves out \
