@@ -12,6 +12,7 @@
 use crate::brdf::MerlBrdf;
 use crate::error::{RenderError, Result};
 use crate::integrator::{render, RenderSettings};
+use crate::sampler::Sampler;
 use crate::scene_sampler::{camera_png, SampledScene, SceneSampler};
 use deepbrdf_data::{MerlTable, Progress, Silent};
 use rayon::prelude::*;
@@ -42,6 +43,9 @@ pub struct SetHeader {
     /// Whether each image also has a linear EXR.
     pub exr: bool,
     pub sampler: SceneSampler,
+    /// The renderer's random numbers (sets made before there was a choice: independent).
+    #[serde(default = "Sampler::stored_default")]
+    pub pixel_sampler: Sampler,
 }
 
 /// One image of the set.
@@ -67,7 +71,14 @@ impl RenderSet {
     /// The set of `count` images of `header`.
     pub fn plan(header: SetHeader, count: usize) -> Result<Self> {
         header.sampler.validate()?;
-        RenderSettings { size: header.size, spp: header.spp, seed: 0, jitter: true }.validate()?;
+        RenderSettings {
+            size: header.size,
+            spp: header.spp,
+            seed: 0,
+            jitter: true,
+            sampler: header.pixel_sampler,
+        }
+        .validate()?;
         if header.materials.is_empty() || count == 0 {
             return Err(RenderError::Invalid(
                 "a render set needs at least one material and one image".into(),
@@ -186,6 +197,7 @@ impl RenderSet {
             spp: self.header.spp,
             seed: s.render_seed,
             jitter: true,
+            sampler: self.header.pixel_sampler,
         };
         let linear = render(&scene, brdf, &settings, &Silent)?;
         let (png, exr) = self.paths(dir, i);
@@ -211,6 +223,7 @@ mod tests {
             spp: 2,
             exr: true,
             sampler: SceneSampler::default(),
+            pixel_sampler: Sampler::Sobol,
         }
     }
 

@@ -1,7 +1,10 @@
 //! The scene and rendering arguments shared by `render`, `compare` and `sheet`:
-//! `--shape`, `--light`, `--view`, `--fov`, `--size`, `--spp`, `--seed`, `--exposure`.
+//! `--shape`, `--light`, `--view`, `--fov`, `--size`, `--spp`, `--seed`, `--sampler`,
+//! `--exposure`.
 use anyhow::Context;
-use deepbrdf_render::{LightSpec, Projection, RenderSettings, Scene, SceneConfig, Shape, Tonemap};
+use deepbrdf_render::{
+    LightSpec, Projection, RenderSettings, Sampler, Scene, SceneConfig, Shape, Tonemap,
+};
 
 #[derive(Debug, Clone, clap::Args)]
 pub struct SceneArgs {
@@ -29,6 +32,9 @@ pub struct SceneArgs {
     /// Seed of the Monte Carlo sampling.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Random numbers: sobol (per-pixel Owen-scrambled Sobol points, less noise) or independent.
+    #[arg(long, default_value = "sobol")]
+    pub sampler: Sampler,
     /// Exposure multiplier applied before tonemapping to 8-bit sRGB.
     #[arg(long, default_value_t = 1.0)]
     pub exposure: f32,
@@ -92,6 +98,7 @@ impl SceneArgs {
             spp: self.spp,
             seed: self.seed,
             jitter: true,
+            sampler: self.sampler,
         }
     }
 

@@ -138,7 +138,7 @@ mod tests {
     use crate::brdf::{Ggx, Lambertian, Sum};
     use crate::light::LightSpec;
     use crate::scene::SceneConfig;
-    use crate::{render, RenderSettings};
+    use crate::{render, RenderSettings, Sampler};
     use deepbrdf_data::merl::coords::HalfDiff;
     use deepbrdf_data::merl::grid;
     use deepbrdf_data::Silent;
@@ -195,7 +195,8 @@ mod tests {
         assert!(lobe.specular_prob > 0.5 && (lobe.alpha / 0.15 - 1.0).abs() < 0.3, "{lobe:?}");
         let merl = MerlBrdf::new(&table).with_sampling(MerlSampling::Lobe(lobe));
         let same_sampling = WithLobe(&analytic, lobe);
-        let settings = RenderSettings { size: 48, spp: 8, seed: 3, jitter: true };
+        let settings =
+            RenderSettings { size: 48, spp: 8, seed: 3, jitter: true, sampler: Sampler::Sobol };
         // Tolerances: the interpolated table errs by a fraction of the lobe's change over one
         // cell (measured RelAE 0.06-0.07%): below 0.5%. The nearest cell errs by up to a
         // cell's change (measured about 3%): below 6%.
@@ -243,7 +244,8 @@ mod tests {
             Sum::new(Lambertian::new([0.3, 0.2, 0.1]), Ggx::new(0.1, [0.9, 0.6, 0.3]), 0.3);
         let table = tabulate(&analytic);
         let merl = MerlBrdf::new(&table);
-        let settings = RenderSettings { size: 40, spp: 16, seed: 3, jitter: true };
+        let settings =
+            RenderSettings { size: 40, spp: 16, seed: 3, jitter: true, sampler: Sampler::Sobol };
         for light in ["const", "sun:40,30"] {
             let scene =
                 SceneConfig { light: light.parse::<LightSpec>().unwrap(), ..Default::default() }

@@ -25,6 +25,7 @@ use deepbrdf_eval::metrics::{ImageRelae, ImageRelaeConfig};
 use deepbrdf_model::recovery::{RecoveryArtifact, RecoveryTarget};
 use deepbrdf_model::DeepBrdf;
 use deepbrdf_render::sheet::{contact_sheet, SheetConfig, Tile};
+use deepbrdf_render::Sampler;
 use deepbrdf_render::{
     camera_png, render, MerlBrdf, Photo, RenderSet, RenderSettings, SceneSampler, Shape,
     Srgb8Image, Tonemap,
@@ -182,6 +183,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                     spp: args.spp,
                     seed: 0x5eed,
                     jitter: true,
+                    sampler: Sampler::Sobol,
                 },
             };
             let relae_of = ImageRelae::new(t, &cfg)?;
@@ -219,6 +221,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                         spp: args.spp,
                         seed: image.scene.render_seed,
                         jitter: true,
+                        sampler: Sampler::Sobol,
                     },
                 };
                 let on_plane = ImageRelae::new(t, &own)?;
@@ -315,6 +318,7 @@ fn nearest_materials(
                     spp,
                     seed: im.scene.render_seed,
                     jitter: true,
+                    sampler: Sampler::Sobol,
                 };
                 let Ok(linear) = render(&scenes[i], &brdf, &settings, &Silent) else {
                     return f64::INFINITY;

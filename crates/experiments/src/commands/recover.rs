@@ -9,6 +9,7 @@ use deepbrdf_model::recovery::artifact::RECOVERY_DIR;
 use deepbrdf_model::recovery::RecoveryArtifact;
 use deepbrdf_model::DeepBrdf;
 use deepbrdf_render::photo::input_preview;
+use deepbrdf_render::Sampler;
 use deepbrdf_render::{render, MerlBrdf, Photo, RenderSettings, SceneConfig, Srgb8Image, Tonemap};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -79,7 +80,8 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         let tile = 128;
         let seen = input_preview(&photo.network_input(tile, &what)?, tile);
         let scene = SceneConfig::default().build()?;
-        let settings = RenderSettings { size: tile, spp: 32, seed: 0, jitter: true };
+        let settings =
+            RenderSettings { size: tile, spp: 32, seed: 0, jitter: true, sampler: Sampler::Sobol };
         let image = render(&scene, &MerlBrdf::new(&table), &settings, progress)?;
         let mut sheet = Srgb8Image::filled(2 * tile, tile, [0, 0, 0]);
         sheet.blit(&seen, 0, 0);

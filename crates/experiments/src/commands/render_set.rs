@@ -12,7 +12,7 @@ use deepbrdf_data::dataset::{binary_files, load_material, DataSource};
 use deepbrdf_data::lock::FolderLock;
 use deepbrdf_data::Progress;
 use deepbrdf_eval::harness::Mode;
-use deepbrdf_render::{RenderSet, SceneSampler, SetHeader, Shape};
+use deepbrdf_render::{RenderSet, Sampler, SceneSampler, SetHeader, Shape};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -49,6 +49,10 @@ pub struct Args {
     /// Also write each image's linear radiance (coverage as alpha) as EXR.
     #[arg(long)]
     pub exr: bool,
+    /// The renderer's random numbers: sobol or independent (a set made before this choice
+    /// existed was rendered with independent: extend it with `--sampler independent`).
+    #[arg(long = "sampler", default_value = "sobol")]
+    pub pixel_sampler: Sampler,
     #[command(flatten)]
     pub data: DataArgs,
 }
@@ -113,6 +117,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         spp: args.spp,
         exr: args.exr,
         sampler,
+        pixel_sampler: args.pixel_sampler,
     };
     let set = RenderSet::plan(header, args.images)?;
     let _lock = FolderLock::acquire(&args.out)?;

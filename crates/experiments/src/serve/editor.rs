@@ -23,6 +23,7 @@ use deepbrdf_data::{MerlTable, Silent};
 use deepbrdf_eval::attributes::{Attributes, FitConfig};
 use deepbrdf_model::regressor::Regressor;
 use deepbrdf_model::DeepBrdf;
+use deepbrdf_render::Sampler;
 use deepbrdf_render::{
     render, Image, MerlBrdf, MerlSampling, RenderSettings, Scene, SceneConfig, Tonemap,
 };
@@ -37,11 +38,16 @@ use tokio::sync::oneshot;
 
 /// The fast preview: 128 px, 4 samples per pixel.
 pub const FAST: RenderSettings =
-    RenderSettings { size: 128, spp: 4, seed: PREVIEW_SEED, jitter: true };
+    RenderSettings { size: 128, spp: 4, seed: PREVIEW_SEED, jitter: true, sampler: Sampler::Sobol };
 /// The refined preview (and the originals): 256 px, 32 samples per pixel, in
 /// [`REFINED_PASSES`] passes of different seeds.
-pub const REFINED: RenderSettings =
-    RenderSettings { size: 256, spp: 32, seed: PREVIEW_SEED, jitter: true };
+pub const REFINED: RenderSettings = RenderSettings {
+    size: 256,
+    spp: 32,
+    seed: PREVIEW_SEED,
+    jitter: true,
+    sampler: Sampler::Sobol,
+};
 /// Passes of the refined preview (a newer request stops it between two).
 pub const REFINED_PASSES: u32 = 8;
 /// Seed of the previews: the same for every edit, so two previews differ by the edit only.

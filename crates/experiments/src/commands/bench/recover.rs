@@ -6,6 +6,7 @@ use crate::stats::median;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::{Progress, Silent};
 use deepbrdf_model::DeepBrdf;
+use deepbrdf_render::Sampler;
 use deepbrdf_render::{camera_png, render, MerlBrdf, Photo, RenderSettings, SceneConfig};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -37,7 +38,13 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         None => {
             let (_, table) = load_material("gold-metallic-paint", &args.cache.cache())?;
             let scene = SceneConfig::default().build()?;
-            let settings = RenderSettings { size: 256, spp: 16, seed: 0, jitter: true };
+            let settings = RenderSettings {
+                size: 256,
+                spp: 16,
+                seed: 0,
+                jitter: true,
+                sampler: Sampler::Sobol,
+            };
             let linear = render(&scene, &MerlBrdf::new(&table), &settings, &Silent)?;
             let path = dir.path().join("photo.png");
             camera_png(&linear, 1.0, 0.0, 0).write_png(&path)?;

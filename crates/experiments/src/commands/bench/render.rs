@@ -8,6 +8,7 @@ use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::{Progress, Silent};
 use deepbrdf_render::brdf::{sample_cosine_hemisphere, InterleavedTable, Rgb};
 use deepbrdf_render::geometry::Vec3;
+use deepbrdf_render::Sampler;
 use deepbrdf_render::{render, Brdf, MerlBrdf, MerlLookup, RenderSettings, SceneConfig, Sum};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -124,7 +125,13 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
 
     // Whole renders: the preview sphere under sun and sky.
     let scene = SceneConfig::default().build()?;
-    let settings = RenderSettings { size: args.size, spp: args.spp, seed: 0, jitter: true };
+    let settings = RenderSettings {
+        size: args.size,
+        spp: args.spp,
+        seed: 0,
+        jitter: true,
+        sampler: Sampler::Sobol,
+    };
     let merl = MerlBrdf::new(&table);
     let analytic = Sum::plastic([0.3, 0.2, 0.1], 0.1, [0.04; 3]);
     let mut results = Vec::new();

@@ -11,7 +11,7 @@ use anyhow::Context;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::{Progress, Silent};
 use deepbrdf_render::{
-    render, Brdf, Image, Lambertian, LightSpec, MerlBrdf, RenderSettings, SceneConfig, Sum,
+    render, Brdf, Image, Lambertian, LightSpec, MerlBrdf, RenderSettings, Sampler, SceneConfig, Sum,
 };
 use std::time::Instant;
 
@@ -34,6 +34,9 @@ pub struct Args {
     /// Samples per pixel.
     #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub spp: u32,
+    /// Samplers to measure, comma separated (sobol, independent): each row once per sampler.
+    #[arg(long, value_delimiter = ',', default_value = "independent,sobol")]
+    pub samplers: Vec<Sampler>,
     #[command(flatten)]
     pub cache: CacheArg,
 }
@@ -93,33 +96,49 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         brdfs.push((name.clone(), Box::new(brdf), build));
     }
     println!(
-        "{:<34} {:<10} {:>9} {:>9} {:>9} {:>11} {:>11} {:>9}",
-        "material", "light", "s/image", "cpu s", "noise", "efficiency", "eff. (cpu)", "build s"
+        "{:<34} {:<10} {:<11} {:>9} {:>9} {:>9} {:>11} {:>11} {:>9}",
+        "material",
+        "light",
+        "sampler",
+        "s/image",
+        "cpu s",
+        "noise",
+        "efficiency",
+        "eff. (cpu)",
+        "build s"
     );
     for light in &args.lights {
         let spec: LightSpec = light.parse().with_context(|| format!("parsing light '{light}'"))?;
         let scene = SceneConfig { light: spec, ..Default::default() }.build()?;
         for (name, brdf, build) in &brdfs {
-            let mut images = Vec::new();
-            let mut seconds = 0.0;
-            let cpu_start = cpu_seconds();
-            for seed in [1, 2] {
-                let settings =
-                    RenderSettings { size: args.size, spp: args.spp, seed, jitter: true };
-                let start = Instant::now();
-                images.push(render(&scene, brdf.as_ref(), &settings, &Silent)?);
-                seconds += start.elapsed().as_secs_f64() / 2.0;
+            for &sampler in &args.samplers {
+                let mut images = Vec::new();
+                let mut seconds = 0.0;
+                let cpu_start = cpu_seconds();
+                for seed in [1, 2] {
+                    let settings = RenderSettings {
+                        size: args.size,
+                        spp: args.spp,
+                        seed,
+                        jitter: true,
+                        sampler,
+                    };
+                    let start = Instant::now();
+                    images.push(render(&scene, brdf.as_ref(), &settings, &Silent)?);
+                    seconds += start.elapsed().as_secs_f64() / 2.0;
+                }
+                let cpu = cpu_start.zip(cpu_seconds()).map(|(a, b)| (b - a) / 2.0);
+                let noise = relative_noise(&images[0], &images[1])
+                    .with_context(|| format!("{name} under {light}: no covered, lit pixels"))?;
+                let efficiency = |s: f64| format!("{:.1}", 1.0 / (noise * noise * s));
+                println!(
+                    "{name:<34} {light:<10} {:<11} {seconds:>9.3} {:>9} {noise:>9.4} {:>11} {:>11} {build:>9.3}",
+                    sampler.to_string(),
+                    cpu.map_or("n/a".into(), |c| format!("{c:.2}")),
+                    efficiency(seconds),
+                    cpu.map_or("n/a".into(), efficiency),
+                );
             }
-            let cpu = cpu_start.zip(cpu_seconds()).map(|(a, b)| (b - a) / 2.0);
-            let noise = relative_noise(&images[0], &images[1])
-                .with_context(|| format!("{name} under {light}: no covered, lit pixels"))?;
-            let efficiency = |s: f64| format!("{:.1}", 1.0 / (noise * noise * s));
-            println!(
-                "{name:<34} {light:<10} {seconds:>9.3} {:>9} {noise:>9.4} {:>11} {:>11} {build:>9.3}",
-                cpu.map_or("n/a".into(), |c| format!("{c:.2}")),
-                efficiency(seconds),
-                cpu.map_or("n/a".into(), efficiency),
-            );
         }
     }
     Ok(())

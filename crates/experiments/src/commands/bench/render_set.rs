@@ -6,6 +6,7 @@ use crate::data_args::CacheArg;
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::Progress;
+use deepbrdf_render::Sampler;
 use deepbrdf_render::{RenderSet, SceneSampler, SetHeader};
 use std::time::Instant;
 
@@ -38,6 +39,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         spp: args.spp,
         exr: false,
         sampler: SceneSampler::default(),
+        pixel_sampler: Sampler::Sobol,
     };
     let set = RenderSet::plan(header, args.images)?;
     let cache = args.cache.cache();
