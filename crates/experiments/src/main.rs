@@ -13,7 +13,6 @@ mod readme_block;
 mod recovery_inputs;
 mod scene_args;
 mod serve;
-mod slices_figure;
 mod stats;
 mod warnings;
 

@@ -8,7 +8,6 @@
 use crate::data_args::DataArgs;
 use crate::progress_log::ProgressLog;
 use crate::readme_block;
-use crate::slices_figure::{self, FIG2_MATERIAL};
 use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::dataset::Dataset;
@@ -16,6 +15,7 @@ use deepbrdf_data::files::write_atomic;
 use deepbrdf_data::Progress;
 use deepbrdf_eval::baseline::BaselineMethod;
 use deepbrdf_eval::deep::{DeepMethod, FitOrigin, FitRecord, NAME};
+use deepbrdf_eval::figures::slices::{self as slices_figure, FIG2_MATERIAL};
 use deepbrdf_eval::harness::{self, HarnessConfig, Materials, Measure, Mode, Results};
 use deepbrdf_eval::robustness::{self, Robustness, NEAREST_FILL};
 use deepbrdf_model::{Preset, TrainConfig};
