@@ -1,7 +1,9 @@
 //! `deepbrdf-eval`: evaluation of measured-BRDF representations (Hu et al., CGF 2020, §4):
-//! the PCA and IPCA baselines, the evaluation harness shared with DeepBRDF, and figures.
+//! the PCA and IPCA baselines, DeepBRDF as a method of the evaluation harness shared with them,
+//! the robustness to missing phi_d slices (Fig. 2), and figures.
 pub mod attributes;
 pub mod baseline;
+pub mod deep;
 pub mod editing;
 pub mod error;
 pub mod figures;
@@ -9,5 +11,6 @@ pub mod harness;
 pub mod ipca;
 pub mod metrics;
 pub mod pca;
+pub mod robustness;
 
 pub use error::{EvalError, Result};

@@ -89,12 +89,29 @@ impl DeepBrdf {
     /// Eq. (2) from the reduced input of Fig. 2: only the phi_d slices in `kept` are used; each
     /// missing slice is filled from its nearest kept one (§3.2) before encoding.
     pub fn encode_partial(&self, table: &MerlTable, kept: &[usize]) -> Result<Vec<f32>> {
+        let (input, mask) = mapped_layout(table, self.reference());
+        self.encode_partial_layout(input, mask, kept)
+    }
+
+    /// [`DeepBrdf::encode_partial`] on a mapped layout and its mask (as
+    /// [`DeepBrdf::encode_layout`] takes them): the slices not in `kept` are filled from their
+    /// nearest kept one (whole image slices, §3.2) and invalid cells zeroed again.
+    pub fn encode_partial_layout(
+        &self,
+        mut input: Vec<f32>,
+        mask: Vec<f32>,
+        kept: &[usize],
+    ) -> Result<Vec<f32>> {
         if kept.is_empty() || kept.iter().any(|&k| k >= N_PHI_D) {
             return Err(ModelError::Invalid(format!(
                 "kept slices must be a non-empty subset of 0..{N_PHI_D}"
             )));
         }
-        let (mut input, mask) = mapped_layout(table, self.reference());
+        if input.len() != INPUT_VALUES || mask.len() != INPUT_VALUES {
+            return Err(ModelError::Invalid(format!(
+                "encoding needs {INPUT_VALUES} layout values and mask entries"
+            )));
+        }
         fill_missing_layout(&mut input, kept);
         for (v, m) in input.iter_mut().zip(&mask) {
             *v *= m;

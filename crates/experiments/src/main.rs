@@ -2,22 +2,17 @@
 mod cli;
 mod commands;
 mod data_args;
-mod deep_method;
 mod device_arg;
 mod editing;
 mod latent_file;
-mod mapped_input;
 mod measured_brdf;
 mod model_arg;
-mod nested_baseline;
 mod progress;
 mod progress_log;
 mod readme_block;
 mod recovery_inputs;
-mod robustness;
 mod scene_args;
 mod serve;
-mod slices_figure;
 mod stats;
 mod warnings;
 

@@ -1,16 +1,19 @@
 //! The PCA and IPCA baselines on MERL tables: a [`Mapping`] of the valid cells ([`Domain`])
-//! followed by a [`LinearBasis`] (eq. 5), as a harness [`Method`] / [`Codec`].
+//! followed by a [`LinearBasis`] (eq. 5), as a harness [`Method`] ([`BaselineCodec`] its codec).
 
 mod artifact;
+mod codec;
 mod domain;
 mod mapping;
 
+pub use codec::BaselineCodec;
 pub use domain::Domain;
 pub use mapping::{Mapping, MappingKind};
 
 use crate::error::{EvalError, Result};
 use crate::harness::{Codec, FoldTraining, Method};
 use crate::pca::LinearBasis;
+use codec::max_k;
 use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::{MerlTable, Progress};
 use std::path::Path;
@@ -128,54 +131,7 @@ impl BaselineBasis {
 
     /// A codec using the first `k` components.
     pub fn codec(self: &Arc<Self>, k: usize) -> Result<BaselineCodec> {
-        if k == 0 || k > self.basis.k() {
-            return Err(EvalError::Invalid(format!(
-                "k = {k} from a {} basis of {} components",
-                self.name,
-                self.basis.k()
-            )));
-        }
-        Ok(BaselineCodec { basis: Arc::clone(self), k })
-    }
-}
-
-/// A [`BaselineBasis`] truncated to `k` components.
-#[derive(Clone, Debug)]
-pub struct BaselineCodec {
-    basis: Arc<BaselineBasis>,
-    k: usize,
-}
-
-impl BaselineCodec {
-    /// The shared fitted basis.
-    pub fn basis(&self) -> &Arc<BaselineBasis> {
-        &self.basis
-    }
-}
-
-impl Codec for BaselineCodec {
-    fn name(&self) -> String {
-        format!("{}-{}", self.basis.name, self.k)
-    }
-
-    fn k(&self) -> usize {
-        self.k
-    }
-
-    fn encode(&self, table: &MerlTable) -> Result<Vec<f32>> {
-        self.basis.encode(table, self.k)
-    }
-
-    fn decode(&self, code: &[f32]) -> Result<MerlTable> {
-        if code.len() != self.k {
-            return Err(EvalError::Invalid(format!(
-                "{} expects {} coefficients, got {}",
-                self.name(),
-                self.k,
-                code.len()
-            )));
-        }
-        self.basis.decode(code)
+        BaselineCodec::new(self, k)
     }
 }
 
@@ -232,7 +188,8 @@ impl BaselineMethod {
         BaselineBasis::fit(&self.name, self.kind, train, k, progress)
     }
 
-    /// One basis at the largest of `ks`, each codec a truncation of it.
+    /// One basis at the largest of `ks`, each codec a truncation of it, all sharing one
+    /// encoding of each BRDF ([`BaselineCodec::nested`]).
     fn nested_codecs(&self, basis: BaselineBasis, ks: &[usize]) -> Result<Vec<Box<dyn Codec>>> {
         let basis = Arc::new(basis);
         if self.keep_last {
@@ -240,7 +197,8 @@ impl BaselineMethod {
                 *slot = Some(Arc::clone(&basis));
             }
         }
-        ks.iter().map(|&k| Ok(Box::new(basis.codec(k)?) as Box<dyn Codec>)).collect()
+        let codecs = BaselineCodec::nested(&basis, ks)?;
+        Ok(codecs.into_iter().map(|c| Box::new(c) as Box<dyn Codec>).collect())
     }
 }
 
@@ -289,10 +247,6 @@ impl Method for BaselineMethod {
         )?;
         self.nested_codecs(basis, ks)
     }
-}
-
-fn max_k(ks: &[usize]) -> Result<usize> {
-    ks.iter().copied().max().ok_or_else(|| EvalError::Invalid("no k given".into()))
 }
 
 #[cfg(test)]

@@ -50,13 +50,12 @@ pub struct Results {
 impl Results {
     /// Mean of `measure` over all evaluated materials (all folds) for `method` at `k`.
     pub fn mean(&self, method: &str, k: usize, measure: Measure) -> Option<f64> {
-        let v: Vec<f64> = self
-            .records
-            .iter()
-            .filter(|r| r.method == method && r.k == k && r.measure == measure)
-            .map(|r| r.value)
-            .collect();
-        (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+        mean(
+            self.records
+                .iter()
+                .filter(|r| r.method == method && r.k == k && r.measure == measure)
+                .map(|r| r.value),
+        )
     }
 
     /// Per-material values of `measure` for `method` at `k`, in `materials` order.
@@ -294,8 +293,15 @@ impl Results {
     }
 }
 
+/// The mean of `values`, summed in order (`None` when there is none).
+pub(crate) fn mean(values: impl IntoIterator<Item = f64>) -> Option<f64> {
+    let v: Vec<f64> = values.into_iter().collect();
+    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+}
+
+/// A CSV field, quoted when it holds a comma, a quote or a line break (RFC 4180).
 pub(crate) fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
+    if s.contains([',', '"', '\n', '\r']) {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {
         s.to_string()

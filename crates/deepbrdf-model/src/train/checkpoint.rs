@@ -147,3 +147,24 @@ pub fn json_close(a: &serde_json::Value, b: &serde_json::Value) -> bool {
         _ => a == b,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::json_close;
+    use serde_json::json;
+
+    #[test]
+    fn configurations_compare_up_to_float_round_off() {
+        let a = json!({"lr": 1e-3, "beta": 0.8999999761581421, "layers": [1, 2], "name": "cpu"});
+        let b = json!({"lr": 1.0000000000000002e-3, "beta": 0.8999999761581421, "layers": [1, 2], "name": "cpu"});
+        assert!(json_close(&a, &b));
+        for c in [
+            json!({"lr": 1.1e-3, "beta": 0.8999999761581421, "layers": [1, 2], "name": "cpu"}),
+            json!({"lr": 1e-3, "beta": 0.8999999761581421, "layers": [1, 3], "name": "cpu"}),
+            json!({"lr": 1e-3, "beta": 0.8999999761581421, "layers": [1, 2], "name": "paper"}),
+            json!({"lr": 1e-3, "beta": 0.8999999761581421, "layers": [1, 2]}),
+        ] {
+            assert!(!json_close(&a, &c), "{c}");
+        }
+    }
+}

@@ -2,12 +2,12 @@
 //! evaluation harness: fit, encode/decode every material at each k, measure, print the summary
 //! table and write the results folder (CSV, markdown, Fig. 3 / Fig. 7 style plots).
 use crate::data_args::DataArgs;
-use crate::deep_method::DeepMethod;
 use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::Progress;
 use deepbrdf_eval::attributes::AttributeMethod;
 use deepbrdf_eval::baseline::BaselineMethod;
+use deepbrdf_eval::deep::DeepMethod;
 use deepbrdf_eval::harness::{self, HarnessConfig, Materials, Measure, Method, Mode};
 use std::path::{Path, PathBuf};
 use std::time::Instant;

@@ -6,18 +6,18 @@
 //! Models are trained into `<out>/models/fold<F>/k<K>` with resume on: rerunning an interrupted
 //! sweep continues where it stopped, and finished models are loaded, not retrained.
 use crate::data_args::DataArgs;
-use crate::deep_method::{DeepMethod, FitOrigin, FitRecord, NAME};
-use crate::nested_baseline::NestedBaseline;
 use crate::progress_log::ProgressLog;
 use crate::readme_block;
-use crate::robustness::{self, Robustness, NEAREST_FILL};
-use crate::slices_figure::{self, FIG2_MATERIAL};
 use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::dataset::Dataset;
 use deepbrdf_data::files::write_atomic;
 use deepbrdf_data::Progress;
+use deepbrdf_eval::baseline::BaselineMethod;
+use deepbrdf_eval::deep::{DeepMethod, FitOrigin, FitRecord, NAME};
+use deepbrdf_eval::figures::slices::{self as slices_figure, FIG2_MATERIAL};
 use deepbrdf_eval::harness::{self, HarnessConfig, Materials, Measure, Mode, Results};
+use deepbrdf_eval::robustness::{self, Robustness, NEAREST_FILL};
 use deepbrdf_model::{Preset, TrainConfig};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -202,7 +202,7 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
         out.display()
     );
 
-    let (pca, ipca) = (NestedBaseline::pca(), NestedBaseline::ipca());
+    let (pca, ipca) = (BaselineMethod::pca(), BaselineMethod::ipca());
     // In k-fold mode the models of earlier folds are loaded again when the robustness step
     // needs them, rather than held in memory.
     let retained = match args.mode {

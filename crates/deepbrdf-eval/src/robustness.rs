@@ -8,13 +8,13 @@
 //! median of the model's training tables as reference: the harness's [`Yardstick`], so the
 //! numbers sit on the same scale as Fig. 3's.
 
-use crate::deep_method::{DeepMethod, NAME};
-use crate::mapped_input::MappedInput;
+use crate::deep::{DeepMethod, MappedInput, NAME};
+use crate::error::{EvalError, Result};
+use crate::figures::{write_chart, LineChart, Series};
+use crate::harness::{csv_field, mean, Fold, Measure, Results, Yardstick};
 use deepbrdf_data::augment::{kept_slices, SliceSelection};
 use deepbrdf_data::files::write_atomic;
 use deepbrdf_data::{MerlTable, Progress};
-use deepbrdf_eval::figures::{write_chart, LineChart, Series};
-use deepbrdf_eval::harness::{Fold, Measure, Results, Yardstick};
 use deepbrdf_model::DeepBrdf;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -69,7 +69,7 @@ pub fn measure(
     ks: &[usize],
     results: &Results,
     progress: &dyn Progress,
-) -> anyhow::Result<Robustness> {
+) -> Result<Robustness> {
     let started = std::time::Instant::now();
     let mut records = Vec::new();
     let kept: Vec<(usize, Vec<usize>)> =
@@ -81,20 +81,23 @@ pub fn measure(
             .iter()
             .map(|&k| {
                 deep.model(fold.index, k).ok_or_else(|| {
-                    anyhow::anyhow!("no {NAME} model was fitted for fold {} at k = {k}", fold.index)
+                    EvalError::Invalid(format!(
+                        "no {NAME} model was fitted for fold {} at k = {k}",
+                        fold.index
+                    ))
                 })
             })
-            .collect::<anyhow::Result<_>>()?;
+            .collect::<Result<_>>()?;
         let Some(first) = models.first() else { break };
         if let Some(m) =
             models.iter().find(|m| m.reference().values() != first.reference().values())
         {
-            anyhow::bail!(
+            return Err(EvalError::Invalid(format!(
                 "the k = {} and k = {} models of fold {} map with different references",
                 first.k(),
                 m.k(),
                 fold.index
-            );
+            )));
         }
         let yardstick = Yardstick::from_reference(first.reference().clone());
         for &i in &fold.test {
@@ -123,7 +126,9 @@ pub fn measure(
                             && &r.material == name
                     })
                     .map(|r| r.value)
-                    .ok_or_else(|| anyhow::anyhow!("no {NAME} result for {name} at k = {k}"))?;
+                    .ok_or_else(|| {
+                        EvalError::Invalid(format!("no {NAME} result for {name} at k = {k}"))
+                    })?;
                 push(1, NAME, Some(k), full);
             }
             for (every, kept) in &kept {
@@ -131,8 +136,10 @@ pub fn measure(
                 let value = yardstick.measure(&original, &filled, &[Measure::MappedMse])?[0];
                 push(*every, NEAREST_FILL, None, value);
                 for model in &models {
-                    let latent = input.encode_partial(model, kept)?;
-                    let recon = model.decode(&latent)?;
+                    let recon = input
+                        .encode_partial(model, kept)
+                        .and_then(|latent| model.decode(&latent))
+                        .map_err(|e| EvalError::method(format!("{NAME}-{}", model.k()), e))?;
                     let value = yardstick.measure(&original, &recon, &[Measure::MappedMse])?[0];
                     push(*every, NAME, Some(model.k()), value);
                 }
@@ -147,13 +154,12 @@ pub fn measure(
 impl Robustness {
     /// Mean over materials of the records of (`every`, `method`, `k`).
     pub fn mean(&self, every: usize, method: &str, k: Option<usize>) -> Option<f64> {
-        let v: Vec<f64> = self
-            .records
-            .iter()
-            .filter(|r| r.every == every && r.method == method && r.k == k)
-            .map(|r| r.mapped_mse)
-            .collect();
-        (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+        mean(
+            self.records
+                .iter()
+                .filter(|r| r.every == every && r.method == method && r.k == k)
+                .map(|r| r.mapped_mse),
+        )
     }
 
     /// The rows of the table: the fill baseline, then DeepBRDF at each k.
@@ -216,7 +222,7 @@ impl Robustness {
     }
 
     /// Writes `robustness.csv` (every record) and `robustness.{png,svg}` into `dir`.
-    pub fn write(&self, dir: &Path) -> anyhow::Result<()> {
+    pub fn write(&self, dir: &Path) -> Result<()> {
         let mut csv = String::from("input,method,k,fold,material,mapped_mse\n");
         for r in &self.records {
             let _ = writeln!(
@@ -257,15 +263,6 @@ impl Robustness {
         };
         write_chart(&chart, &dir.join("robustness"))?;
         Ok(())
-    }
-}
-
-/// A CSV field, quoted when it holds a comma, a quote or a line break.
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
     }
 }
 

@@ -6,15 +6,14 @@
 //! [`RGL_TABULATOR_VERSION`]): a changed network, file or tabulator gives a new key, so stale
 //! tables are never read (and are pruned when replaced).
 //! Files are written to a temporary name and renamed into place. Reading checks the size, the
-//! header (magic, versions, key) and a SHA-256 of the values before trusting anything; a
-//! corrupt or truncated file is recomputed and replaced.
-//!
-//! File layout (little-endian): magic `DBRDFTAB` (8 bytes), format version u32, tabulator version
-//! u32, key (32 bytes), SHA-256 of the values (32 bytes), then [`VALUES`] f32.
+//! header (magic, versions, key) and a checksum of the values before trusting anything
+//! ([`file`]); a corrupt, truncated or foreign file is recomputed and replaced, with a warning.
 
-use crate::error::{DataError, Result};
+mod file;
+
+use crate::error::Result;
 use crate::files::create_parent_and_write;
-use crate::merl::{MerlTable, VALUES};
+use crate::merl::MerlTable;
 use crate::nbrdf::{tabulate, Network, TABULATOR_VERSION};
 use crate::rgl::{RglBrdf, RGL_TABULATOR_VERSION};
 use sha2::{Digest, Sha256};
@@ -22,14 +21,6 @@ use std::path::{Path, PathBuf};
 
 /// Environment variable that overrides the default cache directory.
 pub const CACHE_ENV: &str = "DEEPBRDF_CACHE";
-/// Magic bytes opening a cached table.
-const MAGIC: [u8; 8] = *b"DBRDFTAB";
-/// Version of the cache file layout.
-const FORMAT_VERSION: u32 = 1;
-/// Bytes before the values.
-const HEADER: usize = 8 + 4 + 4 + 32 + 32;
-/// Exact size of a cached table file.
-const FILE_BYTES: u64 = (HEADER + VALUES * 4) as u64;
 /// Hex digits of the key used in file names.
 const KEY_DIGITS: usize = 16;
 
@@ -145,7 +136,7 @@ impl Cache {
         let Some(path) = self.path_of(name, key) else {
             return Ok((compute()?, Outcome::Computed));
         };
-        let outcome = match read_cached(&path, key, version) {
+        let outcome = match file::read(&path, key, version) {
             Ok(Some(table)) => return Ok((table, Outcome::Hit)),
             Ok(None) => Outcome::Computed,
             Err(e) => {
@@ -154,7 +145,7 @@ impl Cache {
             }
         };
         let table = compute()?;
-        store(&path, key, version, &table)?;
+        create_parent_and_write(&path, &file::encode(key, version, &table))?;
         prune_stale(&path, name);
         Ok((table, outcome))
     }
@@ -165,58 +156,6 @@ fn file_safe(name: &str) -> String {
     name.chars()
         .map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' })
         .collect()
-}
-
-/// Reads a cached table: `Ok(None)` if there is no file, `Err` if it is not a valid table
-/// for `key`.
-fn read_cached(path: &Path, key: &[u8; 32], version: u32) -> Result<Option<MerlTable>> {
-    use std::io::Read;
-    let mut file = match std::fs::File::open(path) {
-        Ok(f) => f,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(DataError::io(path, e)),
-    };
-    let len = file.metadata().map_err(|e| DataError::io(path, e))?.len();
-    if len != FILE_BYTES {
-        return Err(DataError::format(
-            path,
-            format!("{len} bytes, a cached table has {FILE_BYTES}"),
-        ));
-    }
-    let mut header = [0u8; HEADER];
-    file.read_exact(&mut header).map_err(|e| DataError::io(path, e))?;
-    let u32_at = |at: usize| {
-        u32::from_le_bytes([header[at], header[at + 1], header[at + 2], header[at + 3]])
-    };
-    if header[..8] != MAGIC || u32_at(8) != FORMAT_VERSION || u32_at(12) != version {
-        return Err(DataError::format(path, "not a cached table of this version"));
-    }
-    if header[16..48] != key[..] {
-        return Err(DataError::format(path, "cached table of another network"));
-    }
-    let mut payload = vec![0u8; VALUES * 4];
-    file.read_exact(&mut payload).map_err(|e| DataError::io(path, e))?;
-    if Sha256::digest(&payload).as_slice() != &header[48..80] {
-        return Err(DataError::format(path, "checksum mismatch"));
-    }
-    let values: Vec<f32> =
-        payload.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
-    drop(payload);
-    MerlTable::from_values(values).map(Some).map_err(|e| DataError::format(path, e.to_string()))
-}
-
-/// Writes a cached table atomically.
-fn store(path: &Path, key: &[u8; 32], version: u32, table: &MerlTable) -> Result<()> {
-    let mut bytes = Vec::with_capacity(FILE_BYTES as usize);
-    bytes.extend(MAGIC);
-    bytes.extend(FORMAT_VERSION.to_le_bytes());
-    bytes.extend(version.to_le_bytes());
-    bytes.extend(key);
-    bytes.extend([0u8; 32]);
-    bytes.extend(table.values().iter().flat_map(|v| v.to_le_bytes()));
-    let digest = Sha256::digest(&bytes[HEADER..]);
-    bytes[48..80].copy_from_slice(&digest);
-    create_parent_and_write(path, &bytes)
 }
 
 /// Removes other cache files of the same material (older keys).
@@ -258,7 +197,7 @@ mod tests {
         let (first, outcome) = cache.tabulated_with_outcome(&net).expect("tabulate");
         assert_eq!(outcome, Outcome::Computed);
         let path = cache.path_for(&net).expect("enabled");
-        assert_eq!(std::fs::metadata(&path).expect("written").len(), FILE_BYTES);
+        assert_eq!(std::fs::metadata(&path).expect("written").len(), file::FILE_BYTES as u64);
         let (again, outcome) = cache.tabulated_with_outcome(&net).expect("hit");
         assert_eq!(outcome, Outcome::Hit);
         assert_eq!(again, first);
@@ -272,7 +211,7 @@ mod tests {
 
         // One flipped bit in the values: caught by the checksum.
         let mut flipped = full.clone();
-        flipped[HEADER + 12345] ^= 0x10;
+        flipped[file::HEADER + 12345] ^= 0x10;
         std::fs::write(&path, &flipped).expect("corrupt");
         let (t, outcome) = cache.tabulated_with_outcome(&net).expect("recompute");
         assert_eq!((outcome, &t), (Outcome::Recomputed, &first));
@@ -288,7 +227,7 @@ mod tests {
 
         // A file holding another network's table under this key's name is not trusted.
         std::fs::copy(&new_path, &path).expect("copy");
-        assert!(read_cached(&path, &Cache::key(&net), TABULATOR_VERSION).is_err());
+        assert!(file::read(&path, &Cache::key(&net), TABULATOR_VERSION).is_err());
         let leftovers: Vec<_> = std::fs::read_dir(path.parent().expect("dir"))
             .expect("list")
             .flatten()

@@ -2,6 +2,8 @@
 //! (rows theta_h, columns theta_d, eq. (1) mapped values in false colour): the original, and
 //! DeepBRDF's reconstructions from all, 1/3 and 1/9 of the slices.
 
+use crate::deep::NAME;
+use crate::error::{EvalError, Result};
 use deepbrdf_data::augment::{kept_slices, SliceSelection};
 use deepbrdf_data::merl::{cell_index, CELLS, N_THETA_D, N_THETA_H};
 use deepbrdf_data::MerlTable;
@@ -26,18 +28,19 @@ const INVALID_COLOUR: [u8; 3] = [60, 60, 60];
 /// (PNG): one row per input (original, all, 1/3, 1/9 of the slices), one column per slice of
 /// [`SLICES`]. All tiles share one colour scale: 0 to the 99.5th percentile of the original's
 /// mapped values, which is returned.
-pub fn write(model: &DeepBrdf, table: &MerlTable, path: &Path) -> anyhow::Result<f32> {
+pub fn write(model: &DeepBrdf, table: &MerlTable, path: &Path) -> Result<f32> {
     let reference = model.reference();
     let mask = table.mask();
     let mut rows: Vec<(String, Vec<f32>)> = vec![("original".into(), reference.map(table))];
     for every in [1, 3, 9] {
-        let latent = if every == 1 {
-            model.encode(table)?
-        } else {
-            model.encode_partial(table, &kept_slices(&SliceSelection::Every(every), 0))?
-        };
+        let recon = match every {
+            1 => model.encode(table),
+            _ => model.encode_partial(table, &kept_slices(&SliceSelection::Every(every), 0)),
+        }
+        .and_then(|latent| model.decode(&latent))
+        .map_err(|e| EvalError::method(format!("{NAME}-{}", model.k()), e))?;
         let label = if every == 1 { "from all".to_string() } else { format!("from 1/{every}") };
-        rows.push((format!("k={} {label}", model.k()), reference.map(&model.decode(&latent)?)));
+        rows.push((format!("k={} {label}", model.k()), reference.map(&recon)));
     }
     let scale = colour_scale(&rows[0].1, &mask);
     let mut tiles = Vec::new();

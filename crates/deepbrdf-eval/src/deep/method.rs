@@ -1,15 +1,17 @@
-//! DeepBRDF (Hu et al., CGF 2020, §3.2) as a method of the evaluation harness, so it runs
-//! through `deepbrdf_eval::harness::run` exactly like PCA and IPCA (§4, Figs. 3 and 7).
+//! DeepBRDF (Hu et al., CGF 2020, §3.2) as a harness [`Method`]: training per fold and k with
+//! resume.
 //!
 //! Each (fold, k) is trained into its own directory `<models>/fold<F>/k<K>` with resume on: an
 //! interrupted sweep continues where it stopped, and a finished model whose provenance matches
 //! (same configuration, data label and materials) is loaded, not retrained.
 
-use crate::mapped_input::InputCache;
+use super::codec::DeepCodec;
+use super::mapped_input::InputCache;
+use super::NAME;
+use crate::error::{EvalError, Result};
+use crate::harness::{Codec, FoldTraining, Method};
 use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::{MerlTable, Progress};
-use deepbrdf_eval::harness::{Codec, FoldTraining, Method};
-use deepbrdf_eval::{EvalError, Result};
 use deepbrdf_model::artifact::MODEL_DIR;
 use deepbrdf_model::burn::tensor::Device;
 use deepbrdf_model::train::{json_close, CHECKPOINT_FILE};
@@ -17,9 +19,6 @@ use deepbrdf_model::{DeepBrdf, ModelArtifact, TrainConfig, TrainingSet as Mapped
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
-
-/// The method's name in tables and plots.
-pub const NAME: &str = "DeepBRDF";
 
 /// The training configuration of one k: a function of k (a preset, possibly with overrides).
 pub type ConfigFor = dyn Fn(usize) -> TrainConfig + Send + Sync;
@@ -195,7 +194,7 @@ impl DeepMethod {
         if self.retained.as_ref().is_none_or(|ks| ks.contains(&k)) {
             models.push((fold, k, model.clone()));
         }
-        Ok(Box::new(DeepCodec { model, cache }))
+        Ok(Box::new(DeepCodec::new(model, cache)))
     }
 
     /// The finished model in `dir` if there is one trained with `config` on `names` from this
@@ -281,51 +280,5 @@ impl Method for DeepMethod {
             .collect::<Result<Vec<_>>>()?;
         self.next_fold.store(fold + 1, Ordering::SeqCst);
         Ok(codecs)
-    }
-}
-
-/// A trained DeepBRDF model as a harness [`Codec`]: eq. (2) to encode, eq. (3) to decode.
-pub struct DeepCodec {
-    model: Arc<DeepBrdf>,
-    cache: Arc<InputCache>,
-}
-
-impl Codec for DeepCodec {
-    fn name(&self) -> String {
-        format!("{NAME}-{}", self.model.k())
-    }
-
-    fn k(&self) -> usize {
-        self.model.k()
-    }
-
-    fn encode(&self, table: &MerlTable) -> Result<Vec<f32>> {
-        let input = self.cache.get(table, self.model.reference());
-        input.encode(&self.model).map_err(|e| EvalError::method(self.name(), e))
-    }
-
-    fn decode(&self, code: &[f32]) -> Result<MerlTable> {
-        self.model.decode(code).map_err(|e| EvalError::method(self.name(), e))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use serde_json::json;
-
-    #[test]
-    fn configurations_compare_up_to_float_round_off() {
-        let a = json!({"lr": 1e-3, "beta": 0.8999999761581421, "layers": [1, 2], "name": "cpu"});
-        let b = json!({"lr": 1.0000000000000002e-3, "beta": 0.8999999761581421, "layers": [1, 2], "name": "cpu"});
-        assert!(json_close(&a, &b));
-        for c in [
-            json!({"lr": 1.1e-3, "beta": 0.8999999761581421, "layers": [1, 2], "name": "cpu"}),
-            json!({"lr": 1e-3, "beta": 0.8999999761581421, "layers": [1, 3], "name": "cpu"}),
-            json!({"lr": 1e-3, "beta": 0.8999999761581421, "layers": [1, 2], "name": "paper"}),
-            json!({"lr": 1e-3, "beta": 0.8999999761581421, "layers": [1, 2]}),
-        ] {
-            assert!(!json_close(&a, &c), "{c}");
-        }
     }
 }

@@ -1,9 +1,9 @@
-//! DeepBRDF's network input for one BRDF, computed once and reused: the eq. (1) mapping of the
-//! table in the §3.2 layout (invalid cells 0) and its validity mask in the same layout. The
-//! harness encodes each material with every k, and the Fig. 2 evaluation encodes it from several
-//! reduced inputs; all of them start from this, so each table is mapped once per fold.
+//! DeepBRDF's network input for one BRDF (Hu et al., CGF 2020, §3.2), computed once and reused:
+//! the eq. (1) mapping of the table in the §3.2 layout (invalid cells 0) and its validity mask
+//! in the same layout ([`deepbrdf_data::network_input::mapped_layout`]). The harness encodes each
+//! material with every k, and the Fig. 2 evaluation encodes it from several reduced inputs; all
+//! of them start from this, so each table is mapped once per fold.
 
-use deepbrdf_data::augment::fill_missing_layout;
 use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::network_input::mapped_layout;
 use deepbrdf_data::MerlTable;
@@ -29,16 +29,10 @@ impl MappedInput {
         model.encode_layout(self.input.to_vec(), self.mask.to_vec())
     }
 
-    /// Eq. (2) from the reduced input of Fig. 2, as `DeepBrdf::encode_partial` builds it: only
-    /// the phi_d slices in `kept` are used, each missing slice filled from its nearest kept one
-    /// (whole image slices, §3.2), and invalid cells zeroed again.
+    /// Eq. (2) from the reduced input of Fig. 2 ([`DeepBrdf::encode_partial_layout`]): only the
+    /// phi_d slices in `kept` are used, each missing slice filled from its nearest kept one.
     pub fn encode_partial(&self, model: &DeepBrdf, kept: &[usize]) -> Result<Vec<f32>> {
-        let mut input = self.input.to_vec();
-        fill_missing_layout(&mut input, kept);
-        for (v, m) in input.iter_mut().zip(self.mask.iter()) {
-            *v *= m;
-        }
-        model.encode_layout(input, self.mask.to_vec())
+        model.encode_partial_layout(self.input.to_vec(), self.mask.to_vec(), kept)
     }
 }
 
