@@ -189,9 +189,20 @@ fn bench_render_noise_prints_noise_and_efficiency() {
     assert!(out.status.success(), "{}", util::stderr(&out));
     let text = util::stdout(&out);
     assert!(text.contains("efficiency"), "{text}");
-    // One row per material and light: Lambertian, plastic and the table, under both lights.
+    // One row per material, light and sampler: Lambertian, plastic and the table, under both
+    // lights, with the independent and the Sobol sampler.
     let rows: Vec<&str> =
         text.lines().filter(|l| l.contains("const") || l.contains("sun:")).collect();
-    assert_eq!(rows.iter().filter(|l| l.starts_with("m ")).count(), 2, "{text}");
-    assert_eq!(rows.len(), 6, "{text}");
+    assert_eq!(rows.iter().filter(|l| l.starts_with("m ")).count(), 4, "{text}");
+    assert_eq!(rows.len(), 12, "{text}");
+    for sampler in ["independent", "sobol"] {
+        assert_eq!(rows.iter().filter(|l| l.contains(sampler)).count(), 6, "{text}");
+    }
+    // The Lambertian under the constant environment is exact with either sampler.
+    assert!(
+        rows.iter()
+            .filter(|l| l.starts_with("lambertian") && l.contains("const"))
+            .all(|l| l.contains("0.0000")),
+        "{text}"
+    );
 }

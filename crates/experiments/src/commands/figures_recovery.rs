@@ -176,6 +176,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             let fitted = attributes_of(&attributes[j])?.table();
             let near = &train_tables[&nearest[j]];
             let recon: [&MerlTable; 4] = [&decoded, &fitted, near, &mean];
+            // The independent sampler, as the image RelAE default (the committed numbers).
             let cfg = ImageRelaeConfig {
                 scene: novel_scene(&set, i),
                 render: RenderSettings {
@@ -183,7 +184,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                     spp: args.spp,
                     seed: 0x5eed,
                     jitter: true,
-                    sampler: Sampler::Sobol,
+                    sampler: Sampler::Independent,
                 },
             };
             let relae_of = ImageRelae::new(t, &cfg)?;
@@ -221,7 +222,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                         spp: args.spp,
                         seed: image.scene.render_seed,
                         jitter: true,
-                        sampler: Sampler::Sobol,
+                        sampler: Sampler::Independent,
                     },
                 };
                 let on_plane = ImageRelae::new(t, &own)?;
