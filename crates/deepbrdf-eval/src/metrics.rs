@@ -6,9 +6,8 @@
 use crate::error::{EvalError, Result};
 use deepbrdf_data::{MerlTable, Silent};
 use deepbrdf_render::image::false_colour;
-use deepbrdf_render::Sampler;
 use deepbrdf_render::{
-    render, Image, MerlBrdf, RenderSettings, Scene, SceneConfig, Srgb8Image, Tonemap,
+    render, Image, MerlBrdf, RenderSettings, Sampler, Scene, SceneConfig, Srgb8Image, Tonemap,
 };
 use serde::{Deserialize, Serialize};
 

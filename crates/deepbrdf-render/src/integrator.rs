@@ -15,6 +15,7 @@
 use super::brdf::{Brdf, Rgb};
 use super::geometry::{Frame, Vec3};
 use super::image::Image;
+use super::light::MAX_STRATEGIES;
 use super::sampler::{PixelSampler, Sampler, MAX_SOBOL_SAMPLES};
 use super::scene::Scene;
 use crate::error::{RenderError, Result};
@@ -164,7 +165,9 @@ fn shade(
     let strategies = env.strategies();
     let u = sampler.shade_point(index, strategies);
     // Only the strategies that draw samples enter the heuristic.
-    let sum_sq = |p: &[f64; 2], b: f64| p[..strategies].iter().map(|x| x * x).sum::<f64>() + b * b;
+    let sum_sq = |p: &[f64; MAX_STRATEGIES], b: f64| {
+        p[..strategies].iter().map(|x| x * x).sum::<f64>() + b * b
+    };
     for i in 0..strategies {
         let (dir, radiance, pdfs) = env.sample_at(i, frame, u.light[i]);
         let wi = frame.to_local(dir);

@@ -77,8 +77,9 @@ pub struct ShadePoint {
 pub enum PixelSampler {
     /// A ChaCha8 stream (the pixel's own).
     Independent(Box<ChaCha8Rng>),
-    /// Per-set scramble seeds of the pixel.
-    Sobol([u32; 2]),
+    /// Per-set scramble seeds of the pixel, and the first set of the latest sample it was
+    /// computed for (the pixel position and the BRDF pair share it: computed once per sample).
+    Sobol { seeds: [u32; 2], first: (u32, [f64; 4]) },
 }
 
 impl PixelSampler {
@@ -93,10 +94,10 @@ impl PixelSampler {
             Sampler::Sobol => {
                 let base = splitmix64(seed ^ splitmix64(pixel.wrapping_add(0x51_7cc1_b727_220a)));
                 let fold = |x: u64| (x ^ (x >> 32)) as u32;
-                Self::Sobol([
-                    fold(splitmix64(base)),
-                    fold(splitmix64(base ^ 0x2545_f491_4f6c_dd1d)),
-                ])
+                let seeds =
+                    [fold(splitmix64(base)), fold(splitmix64(base ^ 0x2545_f491_4f6c_dd1d))];
+                // No sample has index u32::MAX (at most MAX_SOBOL_SAMPLES): nothing cached yet.
+                Self::Sobol { seeds, first: (u32::MAX, [0.0; 4]) }
             }
         }
     }
@@ -107,13 +108,22 @@ impl PixelSampler {
         sobol_burley::sample_4d(index, 0, seeds[set]).map(f64::from)
     }
 
+    /// The first dimension set of sample `index`, computed once per sample (Sobol only).
+    #[inline]
+    fn first_set(seeds: &[u32; 2], first: &mut (u32, [f64; 4]), index: u32) -> [f64; 4] {
+        if first.0 != index {
+            *first = (index, Self::set(seeds, index, 0));
+        }
+        first.1
+    }
+
     /// Position of sample `index` (< [`MAX_SOBOL_SAMPLES`]) in its pixel, in [0, 1)^2.
     #[inline]
     pub fn pixel_offset(&mut self, index: u32) -> [f64; 2] {
         match self {
             Self::Independent(rng) => [rng.random(), rng.random()],
-            Self::Sobol(seeds) => {
-                let s = Self::set(seeds, index, 0);
+            Self::Sobol { seeds, first } => {
+                let s = Self::first_set(seeds, first, index);
                 [s[0], s[1]]
             }
         }
@@ -132,8 +142,8 @@ impl PixelSampler {
                 }
                 ShadePoint { light, brdf: [rng.random(), rng.random()] }
             }
-            Self::Sobol(seeds) => {
-                let (a, b) = (Self::set(seeds, index, 0), Self::set(seeds, index, 1));
+            Self::Sobol { seeds, first } => {
+                let (a, b) = (Self::first_set(seeds, first, index), Self::set(seeds, index, 1));
                 ShadePoint { light: [[b[0], b[1]], [b[2], b[3]]], brdf: [a[2], a[3]] }
             }
         }

@@ -25,9 +25,8 @@ use deepbrdf_eval::metrics::{ImageRelae, ImageRelaeConfig};
 use deepbrdf_model::recovery::{RecoveryArtifact, RecoveryTarget};
 use deepbrdf_model::DeepBrdf;
 use deepbrdf_render::sheet::{contact_sheet, SheetConfig, Tile};
-use deepbrdf_render::Sampler;
 use deepbrdf_render::{
-    camera_png, render, MerlBrdf, Photo, RenderSet, RenderSettings, SceneSampler, Shape,
+    camera_png, render, MerlBrdf, Photo, RenderSet, RenderSettings, Sampler, SceneSampler, Shape,
     Srgb8Image, Tonemap,
 };
 use rayon::prelude::*;

@@ -9,8 +9,9 @@ use deepbrdf_model::recovery::artifact::RECOVERY_DIR;
 use deepbrdf_model::recovery::RecoveryArtifact;
 use deepbrdf_model::DeepBrdf;
 use deepbrdf_render::photo::input_preview;
-use deepbrdf_render::Sampler;
-use deepbrdf_render::{render, MerlBrdf, Photo, RenderSettings, SceneConfig, Srgb8Image, Tonemap};
+use deepbrdf_render::{
+    render, MerlBrdf, Photo, RenderSettings, Sampler, SceneConfig, Srgb8Image, Tonemap,
+};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 

@@ -23,9 +23,8 @@ use deepbrdf_data::{MerlTable, Silent};
 use deepbrdf_eval::attributes::{Attributes, FitConfig};
 use deepbrdf_model::regressor::Regressor;
 use deepbrdf_model::DeepBrdf;
-use deepbrdf_render::Sampler;
 use deepbrdf_render::{
-    render, Image, MerlBrdf, MerlSampling, RenderSettings, Scene, SceneConfig, Tonemap,
+    render, Image, MerlBrdf, MerlSampling, RenderSettings, Sampler, Scene, SceneConfig, Tonemap,
 };
 use serde::Serialize;
 use sha2::{Digest, Sha256};

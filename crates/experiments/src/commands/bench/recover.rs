@@ -6,8 +6,7 @@ use crate::stats::median;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::{Progress, Silent};
 use deepbrdf_model::DeepBrdf;
-use deepbrdf_render::Sampler;
-use deepbrdf_render::{camera_png, render, MerlBrdf, Photo, RenderSettings, SceneConfig};
+use deepbrdf_render::{camera_png, render, MerlBrdf, Photo, RenderSettings, Sampler, SceneConfig};
 use std::path::PathBuf;
 use std::time::Instant;
 

@@ -8,8 +8,9 @@ use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::{Progress, Silent};
 use deepbrdf_render::brdf::{sample_cosine_hemisphere, InterleavedTable, Rgb};
 use deepbrdf_render::geometry::Vec3;
-use deepbrdf_render::Sampler;
-use deepbrdf_render::{render, Brdf, MerlBrdf, MerlLookup, RenderSettings, SceneConfig, Sum};
+use deepbrdf_render::{
+    render, Brdf, MerlBrdf, MerlLookup, RenderSettings, Sampler, SceneConfig, Sum,
+};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::hint::black_box;

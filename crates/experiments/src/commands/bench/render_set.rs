@@ -6,8 +6,7 @@ use crate::data_args::CacheArg;
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::Progress;
-use deepbrdf_render::Sampler;
-use deepbrdf_render::{RenderSet, SceneSampler, SetHeader};
+use deepbrdf_render::{RenderSet, Sampler, SceneSampler, SetHeader};
 use std::time::Instant;
 
 #[derive(Debug, clap::Args)]
