@@ -184,11 +184,13 @@ fn bench_render_noise_prints_noise_and_efficiency() {
             "16",
             "--spp",
             "2",
+            "--pairs",
+            "2",
         ],
     );
     assert!(out.status.success(), "{}", util::stderr(&out));
     let text = util::stdout(&out);
-    assert!(text.contains("efficiency"), "{text}");
+    assert!(text.contains("efficiency") && text.contains("pooled over 2 pairs"), "{text}");
     // One row per material, light and sampler: Lambertian, plastic and the table, under both
     // lights, with the independent and the Sobol sampler.
     let rows: Vec<&str> =
