@@ -129,3 +129,23 @@ fn train_names_a_bad_config_file_and_writes_nothing() {
     );
     util::assert_clean_failure(&out, "missing.json");
 }
+
+#[test]
+fn bench_model_prints_the_decode_time_next_to_ipcas() {
+    let out = util::run(&[
+        "bench", "model", "--preset", "slice", "--k", "3", "--steps", "1", "--decodes", "1",
+    ]);
+    assert!(out.status.success(), "{}", util::stderr(&out));
+    let text = util::stdout(&out);
+    let line = text.lines().find(|l| l.contains("decode vs IPCA's at k = 3")).unwrap_or_else(|| {
+        panic!("no decode comparison: {text}");
+    });
+    // "... A s vs B s (Rx, same run)": both times positive, the ratio theirs.
+    let numbers: Vec<f64> = line
+        .split(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    let [_, deep, ipca, ratio] = numbers[..] else { panic!("{line}") };
+    assert!(deep > 0.0 && ipca > 0.0, "{line}");
+    assert!((ratio - deep / ipca).abs() <= 0.01 + 0.01 * ratio, "{line}");
+}

@@ -161,7 +161,10 @@ pub fn decode(config: &AutoencoderConfig, repeats: usize, device: &Device) -> Re
 }
 
 /// Times `repeats` runs of `f` (at least one) after one untimed warm-up.
-fn timed<T>(repeats: usize, mut f: impl FnMut() -> Result<T>) -> Result<Timing> {
+pub fn timed<T, E>(
+    repeats: usize,
+    mut f: impl FnMut() -> std::result::Result<T, E>,
+) -> std::result::Result<Timing, E> {
     std::hint::black_box(f()?);
     let mut runs = Vec::with_capacity(repeats.max(1));
     for _ in 0..repeats.max(1) {
