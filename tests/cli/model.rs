@@ -133,13 +133,23 @@ fn train_names_a_bad_config_file_and_writes_nothing() {
 #[test]
 fn bench_model_prints_the_decode_time_next_to_ipcas() {
     let out = util::run(&[
-        "bench", "model", "--preset", "slice", "--k", "3", "--steps", "1", "--decodes", "1",
+        "bench",
+        "model",
+        "--preset",
+        "slice",
+        "--k",
+        "3",
+        "--steps",
+        "1",
+        "--decodes",
+        "1",
     ]);
     assert!(out.status.success(), "{}", util::stderr(&out));
     let text = util::stdout(&out);
-    let line = text.lines().find(|l| l.contains("decode vs IPCA's at k = 3")).unwrap_or_else(|| {
-        panic!("no decode comparison: {text}");
-    });
+    let line =
+        text.lines().find(|l| l.contains("decode vs IPCA's at k = 3")).unwrap_or_else(|| {
+            panic!("no decode comparison: {text}");
+        });
     // "... A s vs B s (Rx, same run)": both times positive, the ratio theirs.
     let numbers: Vec<f64> = line
         .split(|c: char| !(c.is_ascii_digit() || c == '.'))

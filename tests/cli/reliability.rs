@@ -1,7 +1,7 @@
-//! CLI tests of what happens around a run rather than inside it (issue 15): two runs on one
-//! output folder, the lock of a killed run, a full disk and a read-only folder, and the long
-//! jobs (`train`, `sweep-k`, `render-set`, `train-recovery`) killed at random moments
-//! ([`kill`]).
+//! CLI tests of what happens around a run rather than inside it (issue 15): a closed standard
+//! output, two runs on one output folder, the lock of a killed run, a full disk and a read-only
+//! folder, and the long jobs (`train`, `sweep-k`, `render-set`, `train-recovery`) killed at
+//! random moments ([`kill`]).
 //!
 //! The disk tests mount a small tmpfs inside a private user and mount namespace
 //! (`unshare --user --map-root-user --mount`), so they need no privileges and leave no mount
@@ -299,4 +299,23 @@ fn train_recovery_killed_at_random_moments_resumes_to_bit_identical_weights() {
         assert!(o.status.success(), "{}", util::stderr(&o));
     };
     kill::kill_trials(&job, dir.path(), kill::trials(2), &check);
+}
+
+#[test]
+fn a_closed_standard_output_ends_the_command_without_a_panic() {
+    // `experiments info m.binary | head -0`: the reader is gone before the first line.
+    use std::os::unix::process::ExitStatusExt;
+    let dir = tempfile::tempdir().unwrap();
+    let data = util::write_data(dir.path(), 1);
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_experiments"))
+        .args(["info", &util::s(&data.join("m0.binary")), "--quiet"])
+        .stdout(writer)
+        .stderr(std::process::Stdio::piped())
+        .output()
+        .unwrap();
+    let stderr = util::stderr(&out);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(out.status.signal(), Some(13), "ended by SIGPIPE: {:?} {stderr}", out.status);
 }

@@ -1,4 +1,5 @@
 //! `experiments`: the DeepBRDF command line. Thin: parse, dispatch, print the error chain.
+mod broken_pipe;
 mod cli;
 mod commands;
 mod data_args;
@@ -21,6 +22,7 @@ use std::process::ExitCode;
 
 fn main() -> ExitCode {
     let cli = cli::Cli::parse();
+    broken_pipe::install(&cli.command);
     warnings::install();
     match commands::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
