@@ -173,7 +173,7 @@ fn load_folder(dir: &Path, progress: &dyn Progress) -> Result<(Vec<String>, Vec<
 }
 
 /// A material's name from its file: the file stem (`chrome.binary` -> `chrome`).
-fn material_name(path: &Path) -> String {
+pub(crate) fn material_name(path: &Path) -> String {
     path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
 }
 

@@ -17,6 +17,7 @@ pub mod network_input;
 pub mod progress;
 pub mod rgl;
 pub mod summary;
+pub mod table_set;
 pub mod testing;
 
 pub use error::{DataError, Result};

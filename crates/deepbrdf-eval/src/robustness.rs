@@ -14,7 +14,8 @@ use crate::figures::{write_chart, LineChart, Series};
 use crate::harness::{csv_field, mean, Fold, Measure, Results, Yardstick};
 use deepbrdf_data::augment::{kept_slices, SliceSelection};
 use deepbrdf_data::files::write_atomic;
-use deepbrdf_data::{MerlTable, Progress};
+use deepbrdf_data::table_set::TableSet;
+use deepbrdf_data::Progress;
 use deepbrdf_model::DeepBrdf;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -63,7 +64,7 @@ pub fn fraction_label(every: usize) -> String {
 #[allow(clippy::too_many_arguments)]
 pub fn measure(
     names: &[String],
-    tables: &[MerlTable],
+    tables: &dyn TableSet,
     folds: &[Fold],
     deep: &DeepMethod,
     ks: &[usize],
@@ -101,10 +102,10 @@ pub fn measure(
         }
         let yardstick = Yardstick::from_reference(first.reference().clone());
         for &i in &fold.test {
-            let (name, table) = (&names[i], &tables[i]);
-            let original = yardstick.original(table);
+            let (name, table) = (&names[i], tables.table(i)?);
+            let original = yardstick.original(&table);
             // Every model of the fold maps with the fold's reference: map the table once.
-            let input = MappedInput::new(table, first.reference());
+            let input = MappedInput::new(&table, first.reference());
             let mut push = |every: usize, method: &str, k: Option<usize>, value: f64| {
                 records.push(RobustnessRecord {
                     every,

@@ -2,6 +2,7 @@
 //! (eq. 3), through the eq. (1) mapping and the §3.2 layout.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use burn::prelude::*;
 use burn::tensor::TensorData;
@@ -27,7 +28,8 @@ use crate::error::{ModelError, Result};
 #[derive(Debug)]
 pub struct DeepBrdf {
     model: Autoencoder,
-    basis: Option<CompactBasis>,
+    /// Shared with other models holding the same basis ([`DeepBrdf::share_basis`]).
+    basis: Option<Arc<CompactBasis>>,
     artifact: ModelArtifact,
     grid_mask: &'static [bool],
     device: Device,
@@ -45,14 +47,28 @@ impl DeepBrdf {
         let (model, compact) = artifact.take_model(&device)?;
         let mut model = model.valid();
         let basis = match compact {
-            Some(basis) => Some(basis),
+            Some(basis) => Some(Arc::new(basis)),
             // A version 1 model: the f32 basis is in the network.
             None if artifact.config().spectral_config().is_some() => {
-                Some(CompactBasis::take_from(&mut model)?)
+                Some(Arc::new(CompactBasis::take_from(&mut model)?))
             }
             None => None,
         };
         Ok(Self { model, basis, artifact, grid_mask: valid_mask(), device })
+    }
+
+    /// Uses `other`'s compact basis instead of this model's own when the two are equal (the
+    /// models of one training set at different k fit the same basis: one copy, 0.67 GB for
+    /// the `cpu` preset, instead of one per model). Returns whether it is shared now.
+    pub fn share_basis(&mut self, other: &DeepBrdf) -> bool {
+        match (&mut self.basis, &other.basis) {
+            (Some(mine), Some(theirs)) if Arc::ptr_eq(mine, theirs) => true,
+            (Some(mine), Some(theirs)) if **mine == **theirs => {
+                *mine = Arc::clone(theirs);
+                true
+            }
+            _ => false,
+        }
     }
 
     /// k, the number of latent values.
@@ -233,7 +249,7 @@ mod tests {
             .unwrap()
             .with_offset(&offset)
             .unwrap()
-            .with_basis(&basis)
+            .with_basis(basis)
             .unwrap();
         (config, network, offset)
     }

@@ -33,7 +33,7 @@ const TILE: usize = 512;
 const TOP: f32 = 32768.0;
 
 /// A basis of K directions over the §3.2 layout, on its support, in f16.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct CompactBasis {
     size: usize,
     /// Layout indices of the support, ascending.

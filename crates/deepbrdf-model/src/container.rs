@@ -47,14 +47,22 @@ impl Container {
 
     /// Writes the container to `path` atomically (temporary file + rename).
     pub fn save(&self, path: &Path, kind: &[u8; 8]) -> Result<()> {
+        let sections: Vec<(&str, &[u8])> =
+            self.sections.iter().map(|(n, d)| (n.as_str(), d.as_slice())).collect();
+        Self::save_sections(path, kind, &sections)
+    }
+
+    /// Writes a container of `sections` to `path` as [`save`](Self::save) does, from borrowed
+    /// data (a checkpoint's 1.7 GB of weights are written where they are, not copied first).
+    pub fn save_sections(path: &Path, kind: &[u8; 8], sections: &[(&str, &[u8])]) -> Result<()> {
         let mut head = Vec::new();
         head.extend_from_slice(MAGIC);
         head.extend_from_slice(kind);
-        head.extend_from_slice(&(self.sections.len() as u32).to_le_bytes());
+        head.extend_from_slice(&(sections.len() as u32).to_le_bytes());
         let mut hasher = Sha256::new();
         let mut parts: Vec<Vec<u8>> = Vec::new();
         let mut pending = head;
-        for (name, data) in &self.sections {
+        for (name, data) in sections {
             pending.extend_from_slice(&(name.len() as u32).to_le_bytes());
             pending.extend_from_slice(name.as_bytes());
             pending.extend_from_slice(&(data.len() as u64).to_le_bytes());
@@ -66,11 +74,11 @@ impl Container {
         parts.push(pending);
         let digest = hasher.finalize();
         let mut slices: Vec<&[u8]> = Vec::new();
-        for (i, (_, data)) in self.sections.iter().enumerate() {
+        for (i, (_, data)) in sections.iter().enumerate() {
             slices.push(&parts[i]);
             slices.push(data);
         }
-        slices.push(&parts[self.sections.len()]);
+        slices.push(&parts[sections.len()]);
         slices.push(&digest);
         write_atomic(path, &slices)
     }

@@ -34,7 +34,7 @@ pub fn fit(
     let set = TrainingSet::from_tables(label, names, tables, &reference)?;
     let trained = train(config, &set, out_dir, resume, progress, device)?;
     drop(set);
-    let artifact = ModelArtifact::from_trained(&trained, reference, label, names, device)?;
+    let artifact = ModelArtifact::from_trained(trained, reference, label, names, device)?;
     artifact.save(&out_dir.join(MODEL_DIR))?;
     DeepBrdf::from_artifact(artifact, device)
 }

@@ -63,8 +63,8 @@ pub fn training_steps(
     let offset = model.offset();
     let fit = match (config.spectral_config(), &offset) {
         (Some(spectral), Some(mean)) => {
-            let fit = crate::principal::fit_basis(&set, mean, spectral.directions)?;
-            model = model.with_basis(&fit.basis)?;
+            let mut fit = crate::principal::fit_basis(&set, mean, spectral.directions)?;
+            model = model.with_basis(std::mem::take(&mut fit.basis))?;
             Some(fit)
         }
         _ => None,
@@ -134,7 +134,7 @@ pub fn decode(config: &AutoencoderConfig, repeats: usize, device: &Device) -> Re
         let basis: Vec<f32> = (0..size * INPUT_VALUES)
             .map(|i| valid[i % INPUT_VALUES] * scale * rng.random_range(-1.0..1.0f32))
             .collect();
-        model = model.with_basis(&basis)?;
+        model = model.with_basis(basis)?;
     }
     let latent: Vec<f32> = (0..config.latent).map(|i| 0.1 * (i as f32 - 2.0)).collect();
     let f32_network =

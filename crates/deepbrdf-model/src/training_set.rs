@@ -5,6 +5,7 @@ use std::sync::Arc;
 
 use deepbrdf_data::layout::{mask_layout, to_layout};
 use deepbrdf_data::mapping::MedianReference;
+use deepbrdf_data::table_set::TableSet;
 use deepbrdf_data::MerlTable;
 use rayon::prelude::*;
 use sha2::{Digest, Sha256};
@@ -109,21 +110,41 @@ impl TrainingSet {
         tables: &[&MerlTable],
         reference: &MedianReference,
     ) -> Result<Self> {
-        if names.len() != tables.len() {
+        let tables = tables.to_vec();
+        let indices: Vec<usize> = (0..tables.len()).collect();
+        Self::from_table_set(label, names, &tables, &indices, reference)
+    }
+
+    /// [`TrainingSet::from_tables`] for tables `indices` of `set`, read one at a time (in
+    /// parallel), each let go once mapped: a streamed set is never all in memory.
+    pub fn from_table_set(
+        label: impl Into<String>,
+        names: &[String],
+        set: &dyn TableSet,
+        indices: &[usize],
+        reference: &MedianReference,
+    ) -> Result<Self> {
+        if names.len() != indices.len() {
             return Err(ModelError::Invalid(format!(
                 "{} names for {} tables",
                 names.len(),
-                tables.len()
+                indices.len()
             )));
         }
-        let inputs: Vec<Vec<f32>> =
-            tables.par_iter().map(|t| to_layout(&reference.map(t))).collect();
+        let mapped = indices
+            .par_iter()
+            .with_max_len(1)
+            .map(|&i| {
+                let t = set.table(i)?;
+                Ok((to_layout(&reference.map(&t)), t.mask()))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let (inputs, cells): (Vec<Vec<f32>>, Vec<Vec<bool>>) = mapped.into_iter().unzip();
         // Masks are built once per distinct validity pattern.
         let mut unique: Vec<(Vec<bool>, Arc<Vec<f32>>)> = Vec::new();
-        let masks = tables
-            .iter()
-            .map(|t| {
-                let cells = t.mask();
+        let masks = cells
+            .into_iter()
+            .map(|cells| {
                 match unique.iter().find(|(c, _)| *c == cells) {
                     Some((_, m)) => m.clone(),
                     None => {

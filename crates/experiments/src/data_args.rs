@@ -5,6 +5,7 @@ use anyhow::Context;
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::cache::Cache;
 use deepbrdf_data::dataset::{DataSource, Dataset};
+use deepbrdf_data::table_set::StreamedDataset;
 use deepbrdf_data::Progress;
 use std::path::{Path, PathBuf};
 
@@ -60,6 +61,14 @@ impl DataArgs {
     /// The cache of tabulated tables.
     pub fn cache(&self) -> Cache {
         self.cache.cache()
+    }
+
+    /// The selected dataset with its tables streamed (from the cache, or its files) where
+    /// they can be, else loaded ([`StreamedDataset::load`]).
+    pub fn load_streamed(&self, progress: &dyn Progress) -> anyhow::Result<StreamedDataset> {
+        let source = self.source();
+        StreamedDataset::load(&source, &self.cache(), progress)
+            .with_context(|| format!("loading the dataset {}", source.label()))
     }
 
     /// Loads the selected dataset.

@@ -237,10 +237,12 @@ impl Method for BaselineMethod {
         ks: &[usize],
         progress: &dyn Progress,
     ) -> Result<Vec<Box<dyn Codec>>> {
+        let tables = train.tables()?;
+        let refs: Vec<&MerlTable> = tables.iter().map(|t| &**t).collect();
         let basis = BaselineBasis::fit_with_reference(
             &self.name,
             self.kind,
-            train.tables,
+            &refs,
             Some(train.reference),
             max_k(ks)?,
             progress,

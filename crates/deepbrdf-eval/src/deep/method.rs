@@ -123,6 +123,7 @@ impl DeepMethod {
         k: usize,
         cache: &Arc<InputCache>,
         set: &mut Option<MappedSet>,
+        fold_models: &mut Vec<Arc<DeepBrdf>>,
         progress: &dyn Progress,
     ) -> Result<Box<dyn Codec>> {
         let names = train.names;
@@ -141,15 +142,21 @@ impl DeepMethod {
                 let mapped = match set {
                     Some(mapped) => mapped,
                     None => set.insert(
-                        MappedSet::from_tables(&self.label, names, train.tables, train.reference)
-                            .map_err(|e| model_error(&dir, e))?,
+                        MappedSet::from_table_set(
+                            &self.label,
+                            names,
+                            train.set,
+                            train.indices,
+                            train.reference,
+                        )
+                        .map_err(|e| model_error(&dir, e))?,
                     ),
                 };
                 let model =
                     deepbrdf_model::train(&config, mapped, &dir, true, progress, &self.device)
                         .and_then(|trained| {
                             let artifact = ModelArtifact::from_trained(
-                                &trained,
+                                trained,
                                 train.reference.clone(),
                                 &self.label,
                                 names,
@@ -168,6 +175,13 @@ impl DeepMethod {
                 (model, FitOrigin::Trained)
             }
         };
+        // The fold's models at other k fitted the same basis: keep one copy of it.
+        let mut model = model;
+        for other in fold_models.iter() {
+            if model.share_basis(other) {
+                break;
+            }
+        }
         let provenance = model.provenance();
         let record = FitRecord {
             fold,
@@ -182,6 +196,7 @@ impl DeepMethod {
             fits.push(record);
         }
         let model = Arc::new(model);
+        fold_models.push(Arc::clone(&model));
         let mut models = self.models.lock().map_err(|_| poisoned())?;
         // Codecs of one fold share the mapped input of the table being evaluated when their
         // models map with the same eq. (1) reference (they do: one fold, one training set).
@@ -261,8 +276,10 @@ impl Method for DeepMethod {
     ) -> Result<Box<dyn Codec>> {
         let fold = self.next_fold.load(Ordering::SeqCst);
         let reference = MedianReference::from_tables(train)?;
-        let set = FoldTraining { tables: train, names, reference: &reference };
-        self.fit_in(fold, &set, k, &Arc::default(), &mut None, progress)
+        let tables = train.to_vec();
+        let indices: Vec<usize> = (0..tables.len()).collect();
+        let set = FoldTraining { set: &tables, indices: &indices, names, reference: &reference };
+        self.fit_in(fold, &set, k, &Arc::default(), &mut None, &mut Vec::new(), progress)
     }
 
     fn fit_fold(
@@ -274,9 +291,10 @@ impl Method for DeepMethod {
         let fold = self.next_fold.load(Ordering::SeqCst);
         let cache = Arc::new(InputCache::default());
         let mut set = None;
+        let mut fold_models = Vec::new();
         let codecs = ks
             .iter()
-            .map(|&k| self.fit_in(fold, train, k, &cache, &mut set, progress))
+            .map(|&k| self.fit_in(fold, train, k, &cache, &mut set, &mut fold_models, progress))
             .collect::<Result<Vec<_>>>()?;
         self.next_fold.store(fold + 1, Ordering::SeqCst);
         Ok(codecs)

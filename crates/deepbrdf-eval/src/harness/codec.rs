@@ -4,18 +4,45 @@
 
 use crate::error::Result;
 use deepbrdf_data::mapping::MedianReference;
+use deepbrdf_data::table_set::TableSet;
 use deepbrdf_data::{MerlTable, Progress};
+use std::borrow::Cow;
 
-/// The training side of one fold as the harness hands it to a [`Method`].
+/// The training side of one fold as the harness hands it to a [`Method`]: training table `j`
+/// is `set.table(indices[j])`, read when asked for ([`FoldTraining::table`]), so a method that
+/// needs one table at a time never holds them all.
 #[derive(Clone, Copy)]
 pub struct FoldTraining<'a> {
-    pub tables: &'a [&'a MerlTable],
-    /// `names[i]` names `tables[i]`.
+    pub set: &'a dyn TableSet,
+    pub indices: &'a [usize],
+    /// `names[j]` names training table `j`.
     pub names: &'a [String],
     /// Eq. (1)'s reference for these tables (their per-value median), computed once per fold
     /// by the harness (the same one its mapped-space measure uses); methods that need it (IPCA,
     /// DeepBRDF) take it from here instead of recomputing it.
     pub reference: &'a MedianReference,
+}
+
+impl<'a> FoldTraining<'a> {
+    /// Number of training tables.
+    pub fn len(&self) -> usize {
+        self.indices.len()
+    }
+
+    /// Whether there is no training table.
+    pub fn is_empty(&self) -> bool {
+        self.indices.is_empty()
+    }
+
+    /// Training table `j`.
+    pub fn table(&self, j: usize) -> Result<Cow<'a, MerlTable>> {
+        Ok(self.set.table(self.indices[j])?)
+    }
+
+    /// Every training table at once (for fits that need them together).
+    pub fn tables(&self) -> Result<Vec<Cow<'a, MerlTable>>> {
+        (0..self.len()).map(|j| self.table(j)).collect()
+    }
 }
 
 /// A fitted representation with `k` coefficients per BRDF.
@@ -57,13 +84,16 @@ pub trait Method: Sync {
     }
 
     /// What the harness calls: fits one codec per entry of `ks` on one fold's training set.
-    /// The default ignores the precomputed reference and calls [`Method::fit_ks`].
+    /// The default reads every training table, ignores the precomputed reference and calls
+    /// [`Method::fit_ks`].
     fn fit_fold(
         &self,
         train: &FoldTraining<'_>,
         ks: &[usize],
         progress: &dyn Progress,
     ) -> Result<Vec<Box<dyn Codec>>> {
-        self.fit_ks(train.tables, train.names, ks, progress)
+        let tables = train.tables()?;
+        let refs: Vec<&MerlTable> = tables.iter().map(|t| &**t).collect();
+        self.fit_ks(&refs, train.names, ks, progress)
     }
 }

@@ -16,6 +16,7 @@ pub use report::{FitTiming, Record, Results};
 
 use crate::error::{EvalError, Result};
 use crate::metrics::{ImageRelae, ImageRelaeConfig};
+use deepbrdf_data::table_set::TableSet;
 use deepbrdf_data::{MerlTable, Progress};
 use std::time::Instant;
 
@@ -55,11 +56,12 @@ impl HarnessConfig {
     }
 }
 
-/// Named tables: the materials of a run (a `Dataset`'s names and tables).
-#[derive(Clone, Copy, Debug)]
+/// Named tables: the materials of a run (a `Dataset`'s names and tables, in memory or
+/// streamed: the harness reads one at a time where it can).
+#[derive(Clone, Copy)]
 pub struct Materials<'a> {
     pub names: &'a [String],
-    pub tables: &'a [MerlTable],
+    pub tables: &'a dyn TableSet,
     /// How the data came about, for the summary ("bundled merl (100)").
     pub label: &'a str,
 }
@@ -124,7 +126,6 @@ pub fn run(
     let mut fits = Vec::new();
     let mut eval_seconds = 0.0;
     for fold in &folds {
-        let tables: Vec<&MerlTable> = fold.train.iter().map(|&i| &train.tables[i]).collect();
         let names: Vec<String> = fold.train.iter().map(|&i| train.names[i].clone()).collect();
         if config.mode != Mode::Generalize {
             // Guard the promise of held-out modes explicitly.
@@ -135,44 +136,56 @@ pub fn run(
                 )));
             }
         }
-        let yardstick = Yardstick::from_training(&tables)?;
-        let mut codecs: Vec<(String, Vec<Box<dyn Codec>>)> = Vec::new();
+        // The median needs every training table at once; they are let go afterwards.
+        let yardstick = {
+            let tables = fold.train.iter().map(|&i| train.tables.table(i)).collect::<Vec<_>>();
+            let tables = tables.into_iter().collect::<deepbrdf_data::Result<Vec<_>>>()?;
+            let refs: Vec<&MerlTable> = tables.iter().map(|t| &**t).collect();
+            Yardstick::from_training(&refs)?
+        };
+        let set = FoldTraining {
+            set: train.tables,
+            indices: &fold.train,
+            names: &names,
+            reference: yardstick.reference(),
+        };
+        // Each method is fitted, evaluated and let go before the next one is fitted (only one
+        // method's codecs in memory at a time); the records are gathered per material and
+        // kept in the order material, method, codec, measure.
+        let mut per_material: Vec<Vec<Record>> = vec![Vec::new(); fold.test.len()];
         for method in methods {
             let t = Instant::now();
-            let set =
-                FoldTraining { tables: &tables, names: &names, reference: yardstick.reference() };
-            let fitted = method.fit_fold(&set, &config.ks, progress)?;
-            if fitted.len() != config.ks.len()
-                || fitted.iter().zip(&config.ks).any(|(c, &k)| c.k() != k)
+            let codecs = method.fit_fold(&set, &config.ks, progress)?;
+            if codecs.len() != config.ks.len()
+                || codecs.iter().zip(&config.ks).any(|(c, &k)| c.k() != k)
             {
                 return Err(EvalError::Invalid(format!(
                     "{} returned codecs for k = {:?}, expected {:?}",
                     method.name(),
-                    fitted.iter().map(|c| c.k()).collect::<Vec<_>>(),
+                    codecs.iter().map(|c| c.k()).collect::<Vec<_>>(),
                     config.ks
                 )));
             }
             fits.push(FitTiming {
                 method: method.name(),
                 fold: fold.index,
-                n_train: tables.len(),
+                n_train: fold.train.len(),
                 seconds: t.elapsed().as_secs_f64(),
             });
-            codecs.push((method.name(), fitted));
-        }
 
-        let t = Instant::now();
-        let steps = fold.test.len() * codecs.iter().map(|c| c.1.len()).sum::<usize>();
-        progress.start(steps as u64, &format!("evaluating fold {}", fold.index + 1));
-        for &i in &fold.test {
-            let original = yardstick.original(&eval_set.tables[i]);
-            let image = match renders {
-                true => Some(ImageRelae::new(&eval_set.tables[i], &ImageRelaeConfig::default())?),
-                false => None,
-            };
-            for (method, list) in &codecs {
-                for codec in list {
-                    let code = codec.encode(&eval_set.tables[i])?;
+            let t = Instant::now();
+            let name = method.name();
+            let steps = fold.test.len() * codecs.len();
+            progress.start(steps as u64, &format!("evaluating fold {}: {name}", fold.index + 1));
+            for (&i, records) in fold.test.iter().zip(per_material.iter_mut()) {
+                let table = eval_set.tables.table(i)?;
+                let original = yardstick.original(&table);
+                let image = match renders {
+                    true => Some(ImageRelae::new(&table, &ImageRelaeConfig::default())?),
+                    false => None,
+                };
+                for codec in &codecs {
+                    let code = codec.encode(&table)?;
                     if code.len() != codec.k() {
                         return Err(EvalError::Invalid(format!(
                             "{} encoded {} to {} coefficients",
@@ -188,7 +201,7 @@ pub fn run(
                     }
                     for (&measure, value) in measure_order.iter().zip(values) {
                         records.push(Record {
-                            method: method.clone(),
+                            method: name.clone(),
                             k: codec.k(),
                             fold: fold.index,
                             material: eval_set.names[i].clone(),
@@ -199,9 +212,10 @@ pub fn run(
                     progress.advance(1);
                 }
             }
+            progress.finish();
+            eval_seconds += t.elapsed().as_secs_f64();
         }
-        progress.finish();
-        eval_seconds += t.elapsed().as_secs_f64();
+        records.extend(per_material.into_iter().flatten());
     }
     Ok(Results {
         mode: config.mode,
@@ -385,8 +399,9 @@ mod tests {
             seed: 0,
             measures: vec![Measure::MappedMse],
         };
-        let train = Materials { names: &names[..5], tables: &tables[..5], label: "first five" };
-        let eval = Materials { names: &names[5..], tables: &tables[5..], label: "last two" };
+        let (first, last) = (tables[..5].to_vec(), tables[5..].to_vec());
+        let train = Materials { names: &names[..5], tables: &first, label: "first five" };
+        let eval = Materials { names: &names[5..], tables: &last, label: "last two" };
         let results = run(&[&pca], &config, train, Some(eval), &Silent).unwrap();
         assert_eq!(results.materials(), names[5..].to_vec());
         assert_eq!(results.fits[0].n_train, 5);

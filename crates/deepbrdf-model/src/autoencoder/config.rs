@@ -320,6 +320,17 @@ impl AutoencoderConfig {
         crate::seeded::with_seed(seed, device, || self.build(device, true))
     }
 
+    /// [`init_seeded`](Self::init_seeded) without the spectral path's basis, for a training
+    /// run that fits the basis and sets it ([`Autoencoder::with_basis`]): the same weights,
+    /// without 1.7 GB of zeros (`cpu` preset) in the meantime (no random draw makes the zeros).
+    pub(crate) fn init_seeded_without_basis(
+        &self,
+        seed: u64,
+        device: &Device,
+    ) -> crate::error::Result<Autoencoder> {
+        crate::seeded::with_seed(seed, device, || self.build(device, false))
+    }
+
     /// Builds the network on `device` with freshly initialised weights (and a zero offset),
     /// drawn from the device's generator as it stands (under the lock of [`crate::seeded`]).
     pub fn init(&self, device: &Device) -> crate::error::Result<Autoencoder> {

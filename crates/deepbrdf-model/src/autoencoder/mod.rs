@@ -111,11 +111,13 @@ impl Autoencoder {
     }
 
     /// Sets the spectral path's basis: K orthonormal rows of `540 * 90 * 90` values in layout
-    /// order ([`crate::principal::fit_basis`]).
-    pub fn with_basis(self, rows: &[f32]) -> crate::error::Result<Self> {
+    /// order ([`crate::principal::fit_basis`]), moved into the network (1.7 GB for the `cpu`
+    /// preset: not copied).
+    pub fn with_basis(self, rows: Vec<f32>) -> crate::error::Result<Self> {
         match self {
             Self::Spectral(mut s) => {
-                s.spectral = s.spectral.with_basis(rows)?;
+                let device = s.devices().into_iter().next().unwrap_or_default();
+                s.spectral = s.spectral.with_basis(rows, &device)?;
                 Ok(Self::Spectral(s))
             }
             Self::Convolutional(_) | Self::Slice(_) => {
@@ -150,6 +152,18 @@ impl Autoencoder {
         match self {
             Self::Spectral(s) => Some(&s.spectral),
             Self::Convolutional(_) | Self::Slice(_) => None,
+        }
+    }
+
+    /// The network without its spectral path's basis (see
+    /// [`SpectralPath::without_basis`]); other networks unchanged.
+    pub(crate) fn without_basis(self) -> Self {
+        match self {
+            Self::Spectral(mut s) => {
+                s.spectral = s.spectral.without_basis();
+                Self::Spectral(s)
+            }
+            other => other,
         }
     }
 

@@ -127,8 +127,8 @@ fn a_fresh_spectral_network_is_its_linear_fit() {
     }
     let offset: Vec<f32> = (0..INPUT_VALUES).map(|i| (i % 13) as f32 / 13.0).collect();
     let model = config.init_seeded(5, &device()).unwrap();
-    assert!(model.clone().with_basis(&basis[1..]).is_err());
-    let model = model.with_basis(&basis).unwrap().with_offset(&offset).unwrap();
+    assert!(model.clone().with_basis(basis[1..].to_vec()).is_err());
+    let model = model.with_basis(basis.clone()).unwrap().with_offset(&offset).unwrap();
     assert_eq!(model.spectral().map(|p| p.size()), Some(3));
     let (a, b, c) = (3.0f32, -2.0f32, 0.5f32);
     let mix = |c: f32| -> Vec<f32> {

@@ -68,13 +68,14 @@ pub(super) fn save<M: Module>(
     state: &TrainState,
 ) -> Result<()> {
     let record_error = |e: RecordError| ModelError::format(path, e.to_string());
-    let mut c = Container::new();
     let state_json = serde_json::to_vec(state)
         .map_err(|e| ModelError::Invalid(format!("cannot serialise the training state: {e}")))?;
-    c.push("state", state_json);
-    c.push("model", model.clone().into_record().into_bytes().map_err(record_error)?.to_vec());
-    c.push("optimizer", optim.into_bytes().map_err(record_error)?.to_vec());
-    c.save(path, CHECKPOINT_KIND)
+    let weights = model.clone().into_record().into_bytes().map_err(record_error)?;
+    let optimizer = optim.into_bytes().map_err(record_error)?;
+    let sections: [(&str, &[u8]); 3] =
+        [("state", &state_json), ("model", &weights), ("optimizer", &optimizer)];
+    let r = Container::save_sections(path, CHECKPOINT_KIND, &sections);
+    r
 }
 
 /// The saved state of the checkpoint at `path`.

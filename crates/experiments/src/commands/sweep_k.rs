@@ -10,8 +10,8 @@ use crate::progress_log::ProgressLog;
 use crate::readme_block;
 use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
-use deepbrdf_data::dataset::Dataset;
 use deepbrdf_data::files::write_atomic;
+use deepbrdf_data::table_set::{StreamedDataset, TableSet};
 use deepbrdf_data::Progress;
 use deepbrdf_eval::baseline::BaselineMethod;
 use deepbrdf_eval::deep::{DeepMethod, FitOrigin, FitRecord, NAME};
@@ -137,14 +137,15 @@ impl Args {
         })
     }
 
-    fn load_data(&self, progress: &dyn Progress) -> anyhow::Result<Dataset> {
-        let mut data = self.data.load(progress)?;
+    /// The training materials, their tables streamed from the table cache (or their files)
+    /// where they can be: the sweep reads each table when it needs it.
+    fn load_data(&self, progress: &dyn Progress) -> anyhow::Result<StreamedDataset> {
+        let mut data = self.data.load_streamed(progress)?;
         if let Some(n) = self.limit {
             if n == 0 {
                 bail!("--limit 0 leaves no material");
             }
-            data.names.truncate(n);
-            data.tables.truncate(n);
+            data.truncate(n);
             data.label = format!("{} (first {})", data.label, data.names.len());
         }
         Ok(data)
@@ -211,7 +212,7 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
     };
     let deep =
         DeepMethod::new(config_for, &models_dir, &data.label, device.clone()).retaining(&retained);
-    let materials = Materials { names: &data.names, tables: &data.tables, label: &data.label };
+    let materials = Materials { names: &data.names, tables: data.tables(), label: &data.label };
     let eval_label = eval.as_ref().map(|e| format!("{} ({} materials)", e.label, e.len()));
     let eval_materials = eval.as_ref().zip(eval_label.as_deref()).map(|(e, label)| Materials {
         names: &e.names,
@@ -223,11 +224,14 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
     results.write(&out)?;
 
     // Fig. 2's reduced inputs, on the materials each fold's models are scored on.
-    let scored = eval.as_ref().unwrap_or(&data);
-    let folds = args.mode.folds(data.names.len(), scored.names.len(), args.seed)?;
+    let scored: (&[String], &dyn TableSet) = match &eval {
+        Some(e) => (&e.names, &e.tables),
+        None => (&data.names, data.tables()),
+    };
+    let folds = args.mode.folds(data.names.len(), scored.0.len(), args.seed)?;
     let robustness = robustness::measure(
-        &scored.names,
-        &scored.tables,
+        scored.0,
+        scored.1,
         &folds,
         &deep,
         &fig2_ks,
@@ -266,12 +270,12 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
 /// at k = 10 when swept (else the middle k), by the model of the fold that evaluates it.
 fn fig2_picture(
     args: &Args,
-    data: &Dataset,
+    (names, tables): (&[String], &dyn TableSet),
     folds: &[harness::Fold],
     deep: &DeepMethod,
     out: &Path,
 ) -> anyhow::Result<Option<String>> {
-    let Some(i) = data.names.iter().position(|n| n == &args.fig2_material) else {
+    let Some(i) = names.iter().position(|n| n == &args.fig2_material) else {
         println!("note: {} is not among the materials; no Fig. 2 picture", args.fig2_material);
         return Ok(None);
     };
@@ -280,7 +284,8 @@ fn fig2_picture(
     let model = deep
         .model(fold, k)
         .with_context(|| format!("no {NAME} model was fitted for fold {fold} at k = {k}"))?;
-    slices_figure::write(&model, &data.tables[i], &out.join("fig2_slices.png"))?;
+    let table = tables.table(i)?;
+    slices_figure::write(&model, &table, &out.join("fig2_slices.png"))?;
     Ok(Some(format!("{} (k = {k})", args.fig2_material)))
 }
 

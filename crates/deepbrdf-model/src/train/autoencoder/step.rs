@@ -16,6 +16,7 @@ use crate::autoencoder::Autoencoder;
 use crate::error::ModelError;
 use crate::loss::masked_mse_centred;
 use crate::principal::PrincipalFit;
+use crate::spectral::SpectralPath;
 use crate::train::run::{on_device, TrainStep};
 use crate::training_set::TrainingSet;
 
@@ -57,6 +58,14 @@ impl<'a> AutoencoderStep<'a> {
         })
     }
 
+    /// Whether `prepare` fits the basis of a spectral network around the training mean (and
+    /// sets it: the network is built without one).
+    fn fits_basis(&self) -> bool {
+        self.config.model.spectral_config().is_some()
+            && self.config.model.mean_offset()
+            && self.config.model.slice_config().is_none()
+    }
+
     /// The number of training samples: the BRDFs, and the augmentations of a slice network.
     pub(crate) fn samples(&self) -> usize {
         match self.config.model.slice_config() {
@@ -70,7 +79,7 @@ impl TrainStep for AutoencoderStep<'_> {
     type Model = Autoencoder;
 
     fn init(&mut self, device: &Device) -> crate::error::Result<Autoencoder> {
-        let model = self.config.model.init_seeded(self.config.seed, device)?;
+        let model = self.skeleton(device)?;
         match self.config.model.mean_offset() {
             true => model.with_offset(&self.data.mean()),
             false => Ok(model),
@@ -79,8 +88,21 @@ impl TrainStep for AutoencoderStep<'_> {
 
     fn skeleton(&mut self, device: &Device) -> crate::error::Result<Autoencoder> {
         // Seeded too: an unseeded draw from the shared generator could fall between the
-        // seeding and the draws of another run's initialisation.
-        self.config.model.init_seeded(self.config.seed, device)
+        // seeding and the draws of another run's initialisation. A fitted basis is not built
+        // (no zero basis in the meantime: no random draw makes it).
+        match self.fits_basis() {
+            true => self.config.model.init_seeded_without_basis(self.config.seed, device),
+            false => self.config.model.init_seeded(self.config.seed, device),
+        }
+    }
+
+    /// Checkpoints leave out a fitted basis (1.7 GB for the `cpu` preset): resuming fits it
+    /// again, to the same bits (the fit is deterministic and the data are checked).
+    fn checkpointed(&self, model: &Autoencoder) -> Autoencoder {
+        match self.fits_basis() {
+            true => model.clone().without_basis(),
+            false => model.clone(),
+        }
     }
 
     /// Fits a spectral network's basis to the training set (again on resume: the fit is
@@ -113,10 +135,12 @@ impl TrainStep for AutoencoderStep<'_> {
         };
         progress.status(&format!("fitting {} principal directions", spectral.directions));
         let mut fit = crate::principal::fit_basis(self.data, mean, spectral.directions)?;
-        if fresh {
-            model = model.with_basis(&fit.basis)?;
+        // Moved into the network (a resumed one has none: checkpoints leave it out; one
+        // saved with its basis keeps it, the same values); only the coordinates are needed.
+        let basis = std::mem::take(&mut fit.basis);
+        if fresh || !model.spectral().is_some_and(SpectralPath::has_basis) {
+            model = model.with_basis(basis)?;
         }
-        fit.basis = Vec::new(); // in the model now; only the coordinates are needed
         self.fit = Some(fit);
         if let Some((_, selections)) = &self.dropout {
             progress.status("projecting the slice-dropout inputs");
