@@ -179,9 +179,11 @@ impl StreamedDataset {
             DataSource::Folder(dir) => Some(StreamedTables::folder(dir, progress)?),
         };
         Ok(match streamed {
-            Some(tables) => {
-                Self { label: source.label(), names: tables.names(), tables: Tables::Streamed(tables) }
-            }
+            Some(tables) => Self {
+                label: source.label(),
+                names: tables.names(),
+                tables: Tables::Streamed(tables),
+            },
             None => Self::from(Dataset::load(source, cache, progress)?),
         })
     }

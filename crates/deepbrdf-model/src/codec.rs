@@ -155,7 +155,7 @@ impl DeepBrdf {
                 self.model.encode(input, mask) // [1, k]
             }
         };
-        let latent: Vec<f32> = latent.into_data().try_into_vec().map_err(read_error)?;
+        let latent = crate::read_back::values(latent, "the latent vector")?;
         if let Some(i) = latent.iter().position(|v| !v.is_finite()) {
             return Err(ModelError::Invalid(format!("latent value {i} is not finite")));
         }
@@ -179,12 +179,12 @@ impl DeepBrdf {
             Tensor::from_data(TensorData::new(latent.to_vec(), [1, latent.len()]), &self.device);
         match (&self.basis, self.model.spectral()) {
             (Some(basis), Some(path)) => {
-                let c: Vec<f32> = path.decode(z).into_data().try_into_vec().map_err(read_error)?; // [1, K]
+                let c = crate::read_back::values(path.decode(z), "the decoded coefficients")?; // [1, K]
                 basis.expand(&c)
             }
             _ => {
                 let out = self.model.decode(z); // [1, 540, 90, 90]
-                out.into_data().try_into_vec().map_err(read_error)
+                crate::read_back::values(out, "the decoded layout")
             }
         }
     }
@@ -200,10 +200,6 @@ impl DeepBrdf {
     pub fn reconstruct(&self, table: &MerlTable) -> Result<MerlTable> {
         self.decode(&self.encode(table)?)
     }
-}
-
-fn read_error(e: impl std::fmt::Debug) -> ModelError {
-    ModelError::Invalid(format!("reading a tensor back failed: {e:?}"))
 }
 
 #[cfg(test)]

@@ -23,6 +23,7 @@ pub mod fit;
 pub mod loss;
 pub mod preset;
 pub mod principal;
+mod read_back;
 mod record;
 pub mod recovery;
 pub mod regressor;

@@ -66,9 +66,7 @@ fn strided_images(layouts: &[&[f32]], device: &Device) -> Tensor<2> {
 }
 
 fn read(t: Tensor<2>) -> Result<Vec<f32>> {
-    t.into_data()
-        .try_into_vec()
-        .map_err(|e| ModelError::Invalid(format!("reading a tensor back failed: {e:?}")))
+    crate::read_back::values(t, "the slice basis fit's product")
 }
 
 /// `sum_i X_i^T (X_i q)` over the layouts, in f64, added group by group in layout order.

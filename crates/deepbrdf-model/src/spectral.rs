@@ -117,11 +117,7 @@ impl SpectralPath {
         let basis = self.basis.take().ok_or_else(taken)?;
         // The parameter is consumed: a network holding the only reference gives its buffer
         // up without a copy.
-        basis
-            .into_value()
-            .into_data()
-            .try_into_vec()
-            .map_err(|e| ModelError::Invalid(format!("reading the spectral basis failed: {e:?}")))
+        crate::read_back::values(basis.into_value(), "the spectral basis")
     }
 
     fn basis(&self) -> Tensor<2> {

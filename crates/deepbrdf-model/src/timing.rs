@@ -137,19 +137,16 @@ pub fn decode(config: &AutoencoderConfig, repeats: usize, device: &Device) -> Re
         model = model.with_basis(basis)?;
     }
     let latent: Vec<f32> = (0..config.latent).map(|i| 0.1 * (i as f32 - 2.0)).collect();
-    let f32_network =
-        match config.spectral_only() {
-            true => Some(timed(repeats, || {
-                let z = Tensor::<2>::from_data(
-                    TensorData::new(latent.clone(), [1, config.latent]),
-                    &device,
-                );
-                model.decode(z).into_data().try_into_vec::<f32>().map_err(|e| {
-                    ModelError::Invalid(format!("reading a tensor back failed: {e:?}"))
-                })
-            })?),
-            false => None,
-        };
+    let f32_network = match config.spectral_only() {
+        true => Some(timed(repeats, || {
+            let z = Tensor::<2>::from_data(
+                TensorData::new(latent.clone(), [1, config.latent]),
+                &device,
+            );
+            crate::read_back::values(model.decode(z), "the decoded layout")
+        })?),
+        false => None,
+    };
     let provenance = Provenance::untrained("benchmark", 0);
     let reference = MedianReference::from_values(vec![0.05; VALUES])?;
     let artifact = ModelArtifact::new(config.clone(), provenance, &model, reference)?;

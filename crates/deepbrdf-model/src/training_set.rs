@@ -144,14 +144,12 @@ impl TrainingSet {
         let mut unique: Vec<(Vec<bool>, Arc<Vec<f32>>)> = Vec::new();
         let masks = cells
             .into_iter()
-            .map(|cells| {
-                match unique.iter().find(|(c, _)| *c == cells) {
-                    Some((_, m)) => m.clone(),
-                    None => {
-                        let m = Arc::new(mask_layout(&cells));
-                        unique.push((cells, m.clone()));
-                        m
-                    }
+            .map(|cells| match unique.iter().find(|(c, _)| *c == cells) {
+                Some((_, m)) => m.clone(),
+                None => {
+                    let m = Arc::new(mask_layout(&cells));
+                    unique.push((cells, m.clone()));
+                    m
                 }
             })
             .collect();

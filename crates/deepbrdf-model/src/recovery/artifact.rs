@@ -332,12 +332,8 @@ impl Predictor {
                 TensorData::new(chunk.to_vec(), [b, 3, self.side, self.side]),
                 &self.device,
             );
-            let y: Vec<f32> = self
-                .net
-                .forward(x)
-                .into_data()
-                .try_into_vec()
-                .map_err(|e| ModelError::Invalid(format!("cannot read the outputs: {e:?}")))?;
+            let y =
+                crate::read_back::values(self.net.forward(x), "the recovery network's outputs")?;
             for row in y.chunks_exact(k) {
                 rows.push(
                     row.iter().enumerate().map(|(j, v)| v * self.scale[j] + self.mean[j]).collect(),

@@ -174,12 +174,10 @@ impl Regressor {
     pub fn predict(&self, attributes: &[f64; 7]) -> Result<Vec<f32>> {
         let x = self.manifest.scaling.standardise(&features(attributes)?);
         let x = Tensor::<2>::from_data(TensorData::new(x.to_vec(), [1, ATTRIBUTES]), &self.device);
-        let out: Vec<f32> = self
-            .net
-            .forward(x, self.manifest.shape.negative_slope)
-            .into_data()
-            .try_into_vec()
-            .map_err(|e| ModelError::Invalid(format!("reading a tensor back failed: {e:?}")))?;
+        let out = crate::read_back::values(
+            self.net.forward(x, self.manifest.shape.negative_slope),
+            "the regressor's output",
+        )?;
         let y = self.manifest.scaling.unstandardise(&out);
         if y.iter().any(|v| !v.is_finite()) {
             return Err(ModelError::Invalid("the regressor's prediction is not finite".into()));

@@ -229,15 +229,8 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
         None => (&data.names, data.tables()),
     };
     let folds = args.mode.folds(data.names.len(), scored.0.len(), args.seed)?;
-    let robustness = robustness::measure(
-        scored.0,
-        scored.1,
-        &folds,
-        &deep,
-        &fig2_ks,
-        &results,
-        progress,
-    )?;
+    let robustness =
+        robustness::measure(scored.0, scored.1, &folds, &deep, &fig2_ks, &results, progress)?;
     robustness.write(&out)?;
 
     let fig2 = fig2_picture(&args, scored, &folds, &deep, &out)?;

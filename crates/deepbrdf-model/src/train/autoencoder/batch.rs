@@ -88,7 +88,7 @@ pub(crate) fn filled_coefficients(
             &device,
         );
         let c: Vec<f32> =
-            path.coefficients(rows).into_data().try_into_vec().map_err(tensor_error)?;
+            crate::read_back::values(path.coefficients(rows), "the batch's coefficients")?;
         *slot = c.chunks(path.size()).map(<[f32]>::to_vec).collect();
     }
     Ok(out)
@@ -166,8 +166,4 @@ pub(crate) fn batch_tensors(
         None => target.clone(),
     };
     Batch { input, target, mask: Tensor::from_data(TensorData::new(mask, shape), device), valid }
-}
-
-pub(crate) fn tensor_error(e: impl std::fmt::Debug) -> ModelError {
-    ModelError::Invalid(format!("reading a tensor back failed: {e:?}"))
 }

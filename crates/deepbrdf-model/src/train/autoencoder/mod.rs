@@ -21,7 +21,7 @@ use crate::train::checkpoint::{self, checkpoint_path};
 use crate::train::log::EpochRecord;
 use crate::train::run::{run, Session};
 use crate::training_set::TrainingSet;
-use batch::{batch_tensors, tensor_error};
+use batch::batch_tensors;
 use step::AutoencoderStep;
 
 /// A trained network and how it was trained.
@@ -134,7 +134,7 @@ pub fn evaluate(
         let batch = chunk.len();
         let diff = deviation * b.mask - b.target; // [batch, 540, 90, 90]
         let sq = (diff.clone() * diff).reshape([batch, INPUT_VALUES]).sum_dim(1); // [batch, 1]
-        let sq: Vec<f32> = sq.into_data().try_into_vec().map_err(tensor_error)?;
+        let sq = crate::read_back::values(sq, "the squared errors")?;
         for (s, v) in sq.iter().zip(&b.valid) {
             errors.push(f64::from(*s) / v.max(1.0));
         }
