@@ -42,6 +42,27 @@ impl<T: Borrow<MerlTable> + Sync> TableSet for Vec<T> {
     }
 }
 
+/// Two sets one after the other: tables `0..first.len()` are `first`'s, the rest `second`'s
+/// (a collection scored and the collections that only train beside it).
+pub struct Concatenated<'a> {
+    pub first: &'a dyn TableSet,
+    pub second: &'a dyn TableSet,
+}
+
+impl TableSet for Concatenated<'_> {
+    fn len(&self) -> usize {
+        self.first.len() + self.second.len()
+    }
+
+    fn table(&self, i: usize) -> Result<Cow<'_, MerlTable>> {
+        match i.checked_sub(self.first.len()) {
+            None => self.first.table(i),
+            Some(j) if j < self.second.len() => self.second.table(j),
+            Some(_) => Err(out_of_range(i, self.len())),
+        }
+    }
+}
+
 fn out_of_range(i: usize, len: usize) -> DataError {
     DataError::Invalid(format!("table {i} requested from a set of {len}"))
 }
@@ -271,5 +292,19 @@ mod tests {
         assert!(StreamedTables::bundled(Collection::RglMeasured, &cache, &Silent)
             .expect("measured")
             .is_none());
+    }
+
+    #[test]
+    fn concatenated_sets_hand_out_both_in_order() {
+        let (_, tables) = crate::testing::sparse_set(3);
+        let first = vec![&tables[0]];
+        let second = vec![&tables[1], &tables[2]];
+        let both = Concatenated { first: &first, second: &second };
+        assert_eq!(both.len(), 3);
+        for (i, table) in tables.iter().enumerate() {
+            assert_eq!(*both.table(i).expect("in range"), *table, "table {i}");
+        }
+        let err = both.table(3).unwrap_err().to_string();
+        assert!(err.contains("table 3 requested from a set of 3"), "{err}");
     }
 }

@@ -20,6 +20,7 @@ use crate::autoencoder::{
 };
 use crate::compact::CompactBasis;
 use crate::error::{ModelError, Result};
+use crate::refine::{image_metric, refine, Refinement};
 
 /// A loaded DeepBRDF model: network, median reference and the MERL grid's validity mask.
 ///
@@ -33,6 +34,8 @@ pub struct DeepBrdf {
     artifact: ModelArtifact,
     grid_mask: &'static [bool],
     device: Device,
+    /// How the `slice` network's encodings are refined through its decoder ([`crate::refine`]).
+    refinement: Refinement,
 }
 
 impl DeepBrdf {
@@ -54,7 +57,8 @@ impl DeepBrdf {
             }
             None => None,
         };
-        Ok(Self { model, basis, artifact, grid_mask: valid_mask(), device })
+        let refinement = Refinement::default();
+        Ok(Self { model, basis, artifact, grid_mask: valid_mask(), device, refinement })
     }
 
     /// Uses `other`'s compact basis instead of this model's own when the two are equal (the
@@ -69,6 +73,19 @@ impl DeepBrdf {
             }
             _ => false,
         }
+    }
+
+    /// Encodes with `refinement` (a `slice` network's encodings are refined through its
+    /// decoder, [`crate::refine`]; [`Refinement::NONE`]: the encoder's latent as it is; other
+    /// networks ignore it).
+    pub fn with_refinement(mut self, refinement: Refinement) -> Self {
+        self.refinement = refinement;
+        self
+    }
+
+    /// How encodings are refined.
+    pub fn refinement(&self) -> Refinement {
+        self.refinement
     }
 
     /// k, the number of latent values.
@@ -149,6 +166,9 @@ impl DeepBrdf {
                 path.encode(c) // [1, k]
             }
             _ => {
+                if let Some(net) = self.model.slice().filter(|_| self.refinement.iterations > 0) {
+                    return self.encode_refined(net, input, mask);
+                }
                 let shape = [1, INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE];
                 let input = Tensor::from_data(TensorData::new(input, shape), &self.device);
                 let mask = Tensor::from_data(TensorData::new(mask, shape), &self.device);
@@ -159,6 +179,42 @@ impl DeepBrdf {
         if let Some(i) = latent.iter().position(|v| !v.is_finite()) {
             return Err(ModelError::Invalid(format!("latent value {i} is not finite")));
         }
+        Ok(latent)
+    }
+
+    /// A `slice` network's encoding of a mapped layout and its mask, refined through its decoder
+    /// from the encoder's latent and the principal-component latent ([`crate::refine`]).
+    fn encode_refined(
+        &self,
+        net: &crate::autoencoder::slice_network::SliceNetwork,
+        mut input: Vec<f32>,
+        mask: Vec<f32>,
+    ) -> Result<Vec<f32>> {
+        for (v, m) in input.iter_mut().zip(&mask) {
+            *v *= m;
+        }
+        let power = self.refinement.radiance_power;
+        let metric = match power == 0.0 {
+            true => None,
+            false => {
+                let basis = net.basis_values()?;
+                let reference = self.reference().values();
+                Some(image_metric(&input, &mask, reference, &basis, power)?)
+            }
+        };
+        let shape = [1, INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE];
+        let masked = Tensor::from_data(TensorData::new(input, shape), &self.device);
+        let a = net.coefficients(masked); // [1, 540 M]
+        let encoded =
+            crate::read_back::values(net.encode_coefficients(a.clone()), "the latent vector")?;
+        let linear = crate::read_back::values(net.linear_latent(a.clone()), "the latent vector")?;
+        let target = crate::read_back::values(a, "the input's coefficients")?;
+        if let Some(i) = target.iter().chain(&encoded).chain(&linear).position(|v| !v.is_finite()) {
+            return Err(ModelError::Invalid(format!("encoding value {i} is not finite")));
+        }
+        let starts = [encoded, linear];
+        let (latent, _) =
+            refine(net, &target, &starts, self.refinement, metric.as_ref(), &self.device)?;
         Ok(latent)
     }
 

@@ -8,6 +8,7 @@
 //!   [`training_set`]: the mapped layouts it trains on.
 //! - [`artifact`]: the self-contained saved model; [`codec`]: encode / decode with it;
 //!   [`compact`]: the spectral basis in the compact form the codec decodes with.
+//!   [`refine`]: encoding by optimisation through the decoder.
 //! - [`fit`]: all of the above on a set of MERL tables.
 //! - [`recovery`]: single-image recovery (§5.2): the CNN from a photo to the latent, Fig. 15.
 pub mod artifact;
@@ -26,6 +27,7 @@ pub mod principal;
 mod read_back;
 mod record;
 pub mod recovery;
+pub mod refine;
 pub mod regressor;
 pub mod seeded;
 pub mod slice_basis;

@@ -108,3 +108,22 @@ pub fn load_collections(
     let label = collections.iter().map(|c| c.name()).collect::<Vec<_>>().join(" + ");
     Ok(Dataset { label, names, tables })
 }
+
+/// Loads bundled `collections` (through the cache of `data`) as extra training materials, each
+/// named `COLLECTION/NAME` (`train --add-collections`, `baselines --add-collections`); the
+/// label joins the collections' names with `+`.
+pub fn load_added(
+    collections: &[Collection],
+    data: &DataArgs,
+    progress: &dyn Progress,
+) -> anyhow::Result<Dataset> {
+    let mut added = Dataset { label: String::new(), names: Vec::new(), tables: Vec::new() };
+    for &collection in collections {
+        let more = Dataset::load(&DataSource::Bundled(collection), &data.cache(), progress)
+            .with_context(|| format!("loading the collection {}", collection.name()))?;
+        added.names.extend(more.names.iter().map(|n| format!("{}/{n}", collection.name())));
+        added.tables.extend(more.tables);
+    }
+    added.label = collections.iter().map(|c| c.name()).collect::<Vec<_>>().join("+");
+    Ok(added)
+}

@@ -12,6 +12,7 @@ mod progress;
 mod progress_log;
 mod readme_block;
 mod recovery_inputs;
+mod refine_arg;
 mod scene_args;
 mod serve;
 mod stats;

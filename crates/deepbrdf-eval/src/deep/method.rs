@@ -14,6 +14,7 @@ use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_model::artifact::MODEL_DIR;
 use deepbrdf_model::burn::tensor::Device;
+use deepbrdf_model::refine::Refinement;
 use deepbrdf_model::train::{json_close, CHECKPOINT_FILE};
 use deepbrdf_model::{DeepBrdf, ModelArtifact, TrainConfig, TrainingSet as MappedSet};
 use std::path::{Path, PathBuf};
@@ -64,6 +65,8 @@ pub struct DeepMethod {
     /// loaded again by [`model`](Self::model)): a loaded `cpu` model holds a 0.67 GB basis, 20
     /// of them do not fit in memory.
     retained: Option<Vec<usize>>,
+    /// How its models refine their encodings ([`deepbrdf_model::refine`]).
+    refinement: Refinement,
 }
 
 impl DeepMethod {
@@ -79,7 +82,14 @@ impl DeepMethod {
             fits: Mutex::new(Vec::new()),
             models: Mutex::new(Vec::new()),
             retained: None,
+            refinement: Refinement::default(),
         }
+    }
+
+    /// Encodes with `refinement` ([`DeepBrdf::with_refinement`]).
+    pub fn refining(mut self, refinement: Refinement) -> Self {
+        self.refinement = refinement;
+        self
     }
 
     /// Keeps only the models of these k in memory after their fold (see [`model`](Self::model)).
@@ -107,7 +117,12 @@ impl DeepMethod {
         kept.or_else(|| {
             let fitted = self.fits().iter().any(|r| r.fold == fold && r.k == k);
             let dir = Self::dir(&self.models_dir, fold, k);
-            fitted.then(|| DeepBrdf::load(&dir, &self.device).ok().map(Arc::new)).flatten()
+            fitted
+                .then(|| {
+                    let model = DeepBrdf::load(&dir, &self.device).ok()?;
+                    Some(Arc::new(model.with_refinement(self.refinement)))
+                })
+                .flatten()
         })
     }
 
@@ -176,7 +191,7 @@ impl DeepMethod {
             }
         };
         // The fold's models at other k fitted the same basis: keep one copy of it.
-        let mut model = model;
+        let mut model = model.with_refinement(self.refinement);
         for other in fold_models.iter() {
             if model.share_basis(other) {
                 break;

@@ -16,7 +16,7 @@ pub use report::{FitTiming, Record, Results};
 
 use crate::error::{EvalError, Result};
 use crate::metrics::{ImageRelae, ImageRelaeConfig};
-use deepbrdf_data::table_set::TableSet;
+use deepbrdf_data::table_set::{Concatenated, TableSet};
 use deepbrdf_data::{MerlTable, Progress};
 use std::time::Instant;
 
@@ -91,8 +91,42 @@ pub fn run(
     eval: Option<Materials>,
     progress: &dyn Progress,
 ) -> Result<Results> {
+    run_with_extra(methods, config, train, None, eval, progress)
+}
+
+/// [`run`], with `extra` materials in every fold's training set and never scored (issue 13:
+/// the other bundled collections beside a k-fold split of `merl`). The folds split `train`
+/// alone, so a k-fold run still never evaluates a material with a codec fitted on it.
+pub fn run_with_extra(
+    methods: &[&dyn Method],
+    config: &HarnessConfig,
+    train: Materials,
+    extra: Option<Materials>,
+    eval: Option<Materials>,
+    progress: &dyn Progress,
+) -> Result<Results> {
     config.validate()?;
     train.check()?;
+    if let Some(extra) = &extra {
+        extra.check()?;
+        if let Some(name) = extra.names.iter().find(|n| train.names.contains(n)) {
+            return Err(EvalError::Invalid(format!(
+                "{name} is both in {} and among the extra training materials ({})",
+                train.label, extra.label
+            )));
+        }
+    }
+    let scored = train.tables.len();
+    let all_names: Vec<String>;
+    let concatenated;
+    let train = match &extra {
+        Some(extra) => {
+            all_names = train.names.iter().chain(extra.names).cloned().collect();
+            concatenated = Concatenated { first: train.tables, second: extra.tables };
+            Materials { names: &all_names, tables: &concatenated, label: train.label }
+        }
+        None => train,
+    };
     if methods.is_empty() {
         return Err(EvalError::Invalid("no method to evaluate".into()));
     }
@@ -121,7 +155,10 @@ pub fn run(
         measure_order.push(Measure::ImageRelae);
     }
     let started = Instant::now();
-    let folds = config.mode.folds(train.tables.len(), eval_set.tables.len(), config.seed)?;
+    let mut folds = config.mode.folds(scored, eval_set.tables.len(), config.seed)?;
+    for fold in &mut folds {
+        fold.train.extend(scored..train.tables.len());
+    }
     let mut records = Vec::new();
     let mut fits = Vec::new();
     let mut eval_seconds = 0.0;
@@ -357,16 +394,21 @@ mod tests {
         }
     }
 
-    #[test]
-    fn kfold_never_evaluates_a_material_it_was_fitted_on() {
-        let (names, tables) = sparse_set(7);
-        let spy = Spy { fitted: Mutex::new(Vec::new()) };
-        let config = HarnessConfig {
+    /// 3-fold mode at k = 2, mapped MSE only.
+    fn kfold3() -> HarnessConfig {
+        HarnessConfig {
             ks: vec![2],
             mode: Mode::KFold { folds: 3 },
             seed: 5,
             measures: vec![Measure::MappedMse],
-        };
+        }
+    }
+
+    #[test]
+    fn kfold_never_evaluates_a_material_it_was_fitted_on() {
+        let (names, tables) = sparse_set(7);
+        let spy = Spy { fitted: Mutex::new(Vec::new()) };
+        let config = kfold3();
         let data = Materials { names: &names, tables: &tables, label: "synthetic" };
         let results = run(&[&spy], &config, data, None, &Silent).unwrap();
         // Every material evaluated exactly once, by a fold that did not train on it.
@@ -387,6 +429,34 @@ mod tests {
         // The same spy fails in-sample mode, which is the point of the check.
         let in_sample = HarnessConfig { mode: Mode::InSample, ..config };
         assert!(run(&[&spy], &in_sample, data, None, &Silent).is_err());
+    }
+
+    #[test]
+    fn extra_materials_train_every_fold_and_are_never_scored() {
+        let (names, tables) = sparse_set(9);
+        let spy = Spy { fitted: Mutex::new(Vec::new()) };
+        let config = kfold3();
+        let (scored, others) = (tables[..6].to_vec(), tables[6..].to_vec());
+        let data = Materials { names: &names[..6], tables: &scored, label: "scored" };
+        let extra = Materials { names: &names[6..], tables: &others, label: "extra" };
+        let results = run_with_extra(&[&spy], &config, data, Some(extra), None, &Silent).unwrap();
+        let mut evaluated = results.materials();
+        evaluated.sort_unstable();
+        assert_eq!(evaluated, names[..6].to_vec());
+        let fitted = spy.fitted.lock().unwrap();
+        assert_eq!(fitted.len(), 3);
+        for (fold, names_fitted) in fitted.iter().enumerate() {
+            assert_eq!(results.fits[fold].n_train, 4 + 3);
+            assert!(names[6..].iter().all(|n| names_fitted.contains(n)), "fold {fold}");
+        }
+        for r in &results.records {
+            assert!(!fitted[r.fold].contains(&r.material), "{} in fold {}", r.material, r.fold);
+        }
+        drop(fitted);
+        // A material in both sets is refused.
+        let clash = Materials { names: &names[5..8], tables: &tables[5..8].to_vec(), label: "x" };
+        let err = run_with_extra(&[&spy], &config, data, Some(clash), None, &Silent).unwrap_err();
+        assert!(err.to_string().contains("sparse-5"), "{err}");
     }
 
     #[test]

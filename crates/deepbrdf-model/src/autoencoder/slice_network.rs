@@ -147,14 +147,41 @@ impl SliceNetwork {
     /// # Shapes
     /// - coefficients: `[batch, 540 * M]` -> `[batch, k]`
     pub fn encode_coefficients(&self, coefficients: Tensor<2>) -> Tensor<2> {
-        let batch = coefficients.dims()[0];
-        let centred = coefficients - self.mean.val().unsqueeze_dim::<2>(0); // [batch, 540 M]
-        let c = centred.matmul(self.components.val().transpose()); // [batch, K]
-        let head = c.clone().slice([0..batch, 0..self.latent]); // [batch, k]
+        let c = self.principal_coordinates(coefficients); // [batch, K]
+        let head = self.head(c.clone()); // [batch, k]
         match self.mlp(&self.encoder, c) {
             Some(f) => head + f,
             None => head,
         }
+    }
+
+    /// `c = P (a - m)`, the K principal coordinates of the coefficients.
+    ///
+    /// # Shapes
+    /// - coefficients: `[batch, 540 * M]` -> `[batch, K]`
+    fn principal_coordinates(&self, coefficients: Tensor<2>) -> Tensor<2> {
+        let centred = coefficients - self.mean.val().unsqueeze_dim::<2>(0); // [batch, 540 M]
+        centred.matmul(self.components.val().transpose())
+    }
+
+    /// `c[..k]`.
+    fn head(&self, c: Tensor<2>) -> Tensor<2> {
+        let batch = c.dims()[0];
+        c.slice([0..batch, 0..self.latent])
+    }
+
+    /// The encoder without its MLP, `c[..k]`: the latent of PCA within the basis' span (where
+    /// [`crate::refine`] starts besides the encoder's latent).
+    ///
+    /// # Shapes
+    /// - coefficients: `[batch, 540 * M]` -> `[batch, k]`
+    pub fn linear_latent(&self, coefficients: Tensor<2>) -> Tensor<2> {
+        self.head(self.principal_coordinates(coefficients))
+    }
+
+    /// The slice basis' values, `M x 8100` row-major.
+    pub fn basis_values(&self) -> crate::error::Result<Vec<f32>> {
+        crate::read_back::values(self.basis.val(), "the slice basis")
     }
 
     /// The Fourier features of the 180 slice centres, phi_d = (p + 1/2) degrees.

@@ -41,9 +41,16 @@ pub struct Args {
     /// --models, or loaded from there when finished).
     #[arg(long, value_name = "NAME,...", value_delimiter = ',', default_value = "pca,ipca")]
     pub methods: Vec<String>,
+    /// Train every method on these bundled collections too, in every fold, and never score
+    /// them (comma-separated; named `COLLECTION/NAME`), e.g. `--mode kfold:5
+    /// --add-collections nielsen2015,rgl,rgl-measured`.
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    pub add_collections: Vec<Collection>,
     /// The preset of the deepbrdf method.
     #[arg(long, default_value = "slice")]
     pub preset: deepbrdf_model::Preset,
+    #[command(flatten)]
+    pub refine: crate::refine_arg::RefineArg,
     /// Where the deepbrdf method trains its models (`fold<F>/k<K>`) [default: <out>/models].
     #[arg(long, value_name = "DIR")]
     pub models: Option<PathBuf>,
@@ -128,7 +135,25 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         None
     };
 
-    let train_label = format!("{} ({} materials)", train.label, train.len());
+    let added = match args.add_collections.is_empty() {
+        true => None,
+        false => Some(crate::data_args::load_added(&args.add_collections, &args.data, progress)?),
+    };
+    let train_label = match &added {
+        Some(a) => format!(
+            "{} ({} materials) + {} ({} materials)",
+            train.label,
+            train.len(),
+            a.label,
+            a.len()
+        ),
+        None => format!("{} ({} materials)", train.label, train.len()),
+    };
+    let added_label = added.as_ref().map(|a| a.label.clone()).unwrap_or_default();
+    let data_label = match &added {
+        Some(a) => format!("{}+{}", train.label, a.label),
+        None => train.label.clone(),
+    };
     let eval_label = eval.as_ref().map(|e| format!("{} ({} materials)", e.label, e.len()));
     let ggx = AttributeMethod::default();
     let preset = args.preset;
@@ -136,10 +161,11 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let deep = DeepMethod::new(
         Box::new(move |k| preset.train_config(k)),
         &models,
-        &train.label,
+        &data_label,
         crate::device_arg::device()?,
     )
-    .retaining(&[]);
+    .retaining(&[])
+    .refining(args.refine.refinement()?);
     let methods: Vec<&dyn Method> = args
         .methods
         .iter()
@@ -150,10 +176,15 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             _ => &ggx,
         })
         .collect();
-    let results = harness::run(
+    let results = harness::run_with_extra(
         &methods,
         &config,
         Materials { names: &train.names, tables: &train.tables, label: &train_label },
+        added.as_ref().map(|a| Materials {
+            names: &a.names,
+            tables: &a.tables,
+            label: &added_label,
+        }),
         eval.as_ref().zip(eval_label.as_deref()).map(|(e, label)| Materials {
             names: &e.names,
             tables: &e.tables,

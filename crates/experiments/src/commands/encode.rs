@@ -19,13 +19,15 @@ pub struct Args {
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
     #[command(flatten)]
+    pub refine: crate::refine_arg::RefineArg,
+    #[command(flatten)]
     pub cache: crate::data_args::CacheArg,
 }
 
 pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     let device = crate::device_arg::device()?;
     let (model_dir, input) = args.model.with_positional(&args.inputs)?;
-    let model = DeepBrdf::load(&model_dir, &device)?;
+    let model = DeepBrdf::load(&model_dir, &device)?.with_refinement(args.refine.refinement()?);
     let (name, table) = load_material(&input, &args.cache.cache())
         .with_context(|| format!("cannot read {input}"))?;
     let latent = model.encode(&table)?;

@@ -36,6 +36,8 @@ pub struct Args {
     /// §3.2's training, for a GPU).
     #[arg(long, default_value = "cpu")]
     pub preset: Preset,
+    #[command(flatten)]
+    pub refine: crate::refine_arg::RefineArg,
     /// Train with this configuration instead of a preset (JSON, as a run's `train_config.json`);
     /// its k is replaced by each k of the sweep.
     #[arg(long, value_name = "FILE")]
@@ -210,8 +212,9 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
         Mode::KFold { .. } => Vec::new(),
         _ => fig2_ks.clone(),
     };
-    let deep =
-        DeepMethod::new(config_for, &models_dir, &data.label, device.clone()).retaining(&retained);
+    let deep = DeepMethod::new(config_for, &models_dir, &data.label, device.clone())
+        .retaining(&retained)
+        .refining(args.refine.refinement()?);
     let materials = Materials { names: &data.names, tables: data.tables(), label: &data.label };
     let eval_label = eval.as_ref().map(|e| format!("{} ({} materials)", e.label, e.len()));
     let eval_materials = eval.as_ref().zip(eval_label.as_deref()).map(|(e, label)| Materials {

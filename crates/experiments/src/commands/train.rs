@@ -8,7 +8,6 @@
 use crate::data_args::DataArgs;
 use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
-use deepbrdf_data::dataset::{DataSource, Dataset};
 use deepbrdf_data::lock::FolderLock;
 use deepbrdf_data::Progress;
 use deepbrdf_model::train::{checkpoint_path, saved_config};
@@ -142,11 +141,10 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         }
     };
     let mut data = args.data.load(progress)?;
-    for &collection in &args.add_collections {
-        let more = Dataset::load(&DataSource::Bundled(collection), &args.data.cache(), progress)
-            .with_context(|| format!("loading the collection {}", collection.name()))?;
-        data.label = format!("{}+{}", data.label, collection.name());
-        data.names.extend(more.names.iter().map(|n| format!("{}/{n}", collection.name())));
+    if !args.add_collections.is_empty() {
+        let more = crate::data_args::load_added(&args.add_collections, &args.data, progress)?;
+        data.label = format!("{}+{}", data.label, more.label);
+        data.names.extend(more.names);
         data.tables.extend(more.tables);
     }
     eprintln!(
