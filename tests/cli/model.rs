@@ -159,3 +159,24 @@ fn bench_model_prints_the_decode_time_next_to_ipcas() {
     assert!(deep > 0.0 && ipca > 0.0, "{line}");
     assert!((ratio - deep / ipca).abs() <= 0.01 + 0.01 * ratio, "{line}");
 }
+
+#[test]
+fn the_configurations_in_configs_load_and_differ_from_the_slice_preset_only_in_augmentation() {
+    use deepbrdf_model::TrainConfig;
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs");
+    let mut seen = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let config = TrainConfig::from_file(&path).unwrap_or_else(|e| panic!("{path:?}: {e}"));
+        let mut preset = TrainConfig::slice(config.model.latent);
+        let slice = config.model.slice_config().expect("a slice configuration");
+        let augmentation = slice.augmentation.clone();
+        if let deepbrdf_model::autoencoder::Architecture::Slice(s) = &mut preset.model.architecture {
+            assert_ne!(s.augmentation, augmentation, "{path:?} is the preset");
+            s.augmentation = augmentation;
+        }
+        assert_eq!(serde_json::to_value(&preset).unwrap(), serde_json::to_value(&config).unwrap());
+        seen += 1;
+    }
+    assert!(seen >= 2, "configs/ holds the ablation configurations");
+}
