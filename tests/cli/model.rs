@@ -171,7 +171,8 @@ fn the_configurations_in_configs_load_and_differ_from_the_slice_preset_only_in_a
         let mut preset = TrainConfig::slice(config.model.latent);
         let slice = config.model.slice_config().expect("a slice configuration");
         let augmentation = slice.augmentation.clone();
-        if let deepbrdf_model::autoencoder::Architecture::Slice(s) = &mut preset.model.architecture {
+        if let deepbrdf_model::autoencoder::Architecture::Slice(s) = &mut preset.model.architecture
+        {
             assert_ne!(s.augmentation, augmentation, "{path:?} is the preset");
             s.augmentation = augmentation;
         }

@@ -117,6 +117,11 @@ pub fn run_with_extra(
         }
     }
     let scored = train.tables.len();
+    // The summary's training data names the extra materials; its evaluation data does not.
+    let train_label = match &extra {
+        Some(extra) => format!("{} + {}", train.label, extra.label),
+        None => train.label.to_string(),
+    };
     let all_names: Vec<String>;
     let concatenated;
     let train = match &extra {
@@ -260,7 +265,7 @@ pub fn run_with_extra(
         ks: config.ks.clone(),
         methods: methods.iter().map(|m| m.name()).collect(),
         measures: config.measures.clone(),
-        train_label: train.label.to_string(),
+        train_label,
         eval_label: eval_set.label.to_string(),
         records,
         fits,
@@ -443,6 +448,10 @@ mod tests {
         let mut evaluated = results.materials();
         evaluated.sort_unstable();
         assert_eq!(evaluated, names[..6].to_vec());
+        assert_eq!(
+            (results.train_label.as_str(), results.eval_label.as_str()),
+            ("scored + extra", "scored")
+        );
         let fitted = spy.fitted.lock().unwrap();
         assert_eq!(fitted.len(), 3);
         for (fold, names_fitted) in fitted.iter().enumerate() {

@@ -139,17 +139,9 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         true => None,
         false => Some(crate::data_args::load_added(&args.add_collections, &args.data, progress)?),
     };
-    let train_label = match &added {
-        Some(a) => format!(
-            "{} ({} materials) + {} ({} materials)",
-            train.label,
-            train.len(),
-            a.label,
-            a.len()
-        ),
-        None => format!("{} ({} materials)", train.label, train.len()),
-    };
-    let added_label = added.as_ref().map(|a| a.label.clone()).unwrap_or_default();
+    let train_label = format!("{} ({} materials)", train.label, train.len());
+    let added_label =
+        added.as_ref().map(|a| format!("{} ({} materials)", a.label, a.len())).unwrap_or_default();
     let data_label = match &added {
         Some(a) => format!("{}+{}", train.label, a.label),
         None => train.label.clone(),
