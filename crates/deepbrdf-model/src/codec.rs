@@ -83,11 +83,6 @@ impl DeepBrdf {
         self
     }
 
-    /// How encodings are refined.
-    pub fn refinement(&self) -> Refinement {
-        self.refinement
-    }
-
     /// k, the number of latent values.
     pub fn k(&self) -> usize {
         self.model.latent()

@@ -135,10 +135,9 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         None
     };
 
-    let added = match args.add_collections.is_empty() {
-        true => None,
-        false => Some(crate::data_args::load_added(&args.add_collections, &args.data, progress)?),
-    };
+    let added = (!args.add_collections.is_empty())
+        .then(|| crate::data_args::load_added(&args.add_collections, &args.data, progress))
+        .transpose()?;
     let train_label = format!("{} ({} materials)", train.label, train.len());
     let added_label =
         added.as_ref().map(|a| format!("{} ({} materials)", a.label, a.len())).unwrap_or_default();
