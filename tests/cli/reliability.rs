@@ -185,7 +185,8 @@ fn sweep_k_killed_at_random_moments_continues_to_identical_results() {
         let mut cmd = Command::new(exe);
         cmd.args(["sweep-k", "--data", &s(&data), "--ks", "1,2", "--train-config"])
             .args([s(&config_path), "--out".into(), s(out), "--fig2-material".into(), "m1".into()])
-            .args(["--measures", "mapped_mse", "--fig2-ks", "2", "-q"]);
+            .args(["--measures", "mapped_mse", "--fig2-ks", "2", "-q"])
+            .args(["--mode", "in-sample", "--deep-ks", "all"]);
         spawn(cmd)
     };
     let outputs = |out: &Path| {

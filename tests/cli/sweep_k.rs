@@ -24,15 +24,19 @@ fn tiny_config(path: &Path) {
     config.save(path).expect("writing the training configuration");
 }
 
-/// `sweep-k` on `data` at k = 1, 2 with the training configuration `config` into `out`, the
-/// Fig. 2 picture of m1, then `extra`.
+/// `sweep-k` on `data` at k = 1, 2 (DeepBRDF at both) with the training configuration
+/// `config` into `out`, the Fig. 2 picture of m1, in-sample unless `extra` names a mode, then
+/// `extra`.
 fn sweep_args(data: &Path, config: &Path, out: &Path, extra: &[&str]) -> Vec<String> {
     let s = |p: &Path| p.to_str().unwrap().to_string();
-    let mut args: Vec<String> = ["sweep-k", "--data", &s(data), "--ks", "1,2"]
+    let mut args: Vec<String> = ["sweep-k", "--data", &s(data), "--ks", "1,2", "--deep-ks", "all"]
         .into_iter()
         .chain(["--train-config", &s(config), "--out", &s(out), "--fig2-material", "m1"])
         .map(str::to_string)
         .collect();
+    if !extra.contains(&"--mode") {
+        args.extend(["--mode".to_string(), "in-sample".to_string()]);
+    }
     args.extend(extra.iter().map(|a| a.to_string()));
     args
 }
@@ -44,8 +48,9 @@ fn sweep_k_writes_results_and_reuses_trained_models() {
     let config = dir.path().join("tiny.json");
     tiny_config(&config);
     let readme = dir.path().join("README.md");
-    std::fs::write(&readme, "# x\n<!-- sweep-k:begin -->\nold\n<!-- sweep-k:end -->\nend\n")
-        .unwrap();
+    let held_out = "<!-- sweep-k:begin -->\nheld out\n<!-- sweep-k:end -->\n";
+    let in_sample = "<!-- sweep-k-in-sample:begin -->\nstale block\n<!-- sweep-k-in-sample:end -->\n";
+    std::fs::write(&readme, format!("# x\n{in_sample}{held_out}end\n")).unwrap();
     let out = dir.path().join("out");
     let readme_arg = readme.to_str().unwrap().to_string();
     let args =
@@ -85,15 +90,17 @@ fn sweep_k_writes_results_and_reuses_trained_models() {
     // Per material: DeepBRDF from all slices at 2 k, and per reduced input (2) the fill and 2 k.
     assert_eq!(robustness.lines().count(), 1 + 3 * (2 + 2 * 3), "{robustness}");
     let md = std::fs::read_to_string(&readme).unwrap();
+    // The in-sample run rewrites its own block and leaves the held-out one alone.
     assert!(
-        md.starts_with("# x\n<!-- sweep-k:begin -->\n")
-            && md.ends_with("<!-- sweep-k:end -->\nend\n"),
+        md.starts_with("# x\n<!-- sweep-k-in-sample:begin -->\n")
+            && md.ends_with(&format!("<!-- sweep-k-in-sample:end -->\n{held_out}end\n")),
         "{md}"
     );
+    assert!(md.contains("**In-sample**"), "{md}");
     assert!(
         md.contains("| IPCA |")
             && md.contains("out/error_vs_k_mapped_mse.png")
-            && !md.contains("old"),
+            && !md.contains("stale block"),
         "{md}"
     );
 
@@ -108,6 +115,43 @@ fn sweep_k_writes_results_and_reuses_trained_models() {
     };
     assert_eq!(recorded(&training), recorded(&first_training), "{first_training}\n{training}");
     assert_eq!(std::fs::read_to_string(out.join("results.csv")).unwrap(), results);
+}
+
+/// The default run is held out: 5-fold, PCA and IPCA at every k, DeepBRDF at one (the middle
+/// k when 10 is not swept), every material scored by methods that never saw it, and the
+/// summary says so before any number.
+#[test]
+fn sweep_k_by_default_is_held_out_with_deepbrdf_at_one_k() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = util::write_data(dir.path(), 6);
+    let config = dir.path().join("tiny.json");
+    tiny_config(&config);
+    let out = dir.path().join("out");
+    let (data, config, out_arg) = (util::s(&data), util::s(&config), util::s(&out));
+    let args = ["sweep-k", "--data", &data, "--ks", "1,2,3", "--train-config", &config];
+    let mut args: Vec<&str> = args.into_iter().chain(["--out", &out_arg]).collect();
+    args.extend(["--measures", "mapped_mse", "--fig2-material", "m1"]);
+    let o = util::run_in(dir.path(), &args);
+    assert!(o.status.success(), "{}", util::stderr(&o));
+    let rows = rows(&std::fs::read_to_string(out.join("results.csv")).unwrap());
+    // PCA and IPCA: 3 k x 6 materials; DeepBRDF: k = 2 only.
+    assert_eq!(rows.len(), 2 * 3 * 6 + 6, "{rows:?}");
+    assert!(rows.iter().filter(|r| r.0 == "DeepBRDF").all(|r| r.1 == 2));
+    let training = std::fs::read_to_string(out.join("training.csv")).unwrap();
+    assert_eq!(training.lines().filter(|l| l.contains(",trained,")).count(), 5, "{training}");
+    for fold in 0..5 {
+        assert!(out.join(format!("models/fold{fold}/k2/model/model.json")).is_file());
+    }
+    let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    let held_out = summary.find("**Held out**: 5-fold").expect(&summary);
+    let first_number = summary.find("- k = 2, ").expect(&summary);
+    assert!(held_out < first_number, "{summary}");
+    assert!(summary.contains("DeepBRDF at k = 2 vs PCA and IPCA at k = 3"), "{summary}");
+    let stdout = util::stdout(&o);
+    assert!(stdout.contains("**Held out**") && stdout.contains("| DeepBRDF | - |"), "{stdout}");
+    // A DeepBRDF k outside the swept ones is refused before anything is trained.
+    let bad: Vec<&str> = args.iter().copied().chain(["--deep-ks", "4"]).collect();
+    util::assert_clean_failure(&util::run_in(dir.path(), &bad), "--deep-ks: k = 4");
 }
 
 #[test]

@@ -62,6 +62,13 @@ pub trait Method: Sync {
     /// The method's name in tables and plots ("PCA", "IPCA", "DeepBRDF").
     fn name(&self) -> String;
 
+    /// The k of `requested` this method is fitted and scored at (default: all of them). A
+    /// method that is costly to fit (DeepBRDF trains one network per fold and k) can run at a
+    /// few k while the cheap ones sweep them all; the tables show "-" where a method has none.
+    fn ks(&self, requested: &[usize]) -> Vec<usize> {
+        requested.to_vec()
+    }
+
     /// Fits a codec of `k` coefficients to `train` (`names[i]` names `train[i]`).
     fn fit(
         &self,

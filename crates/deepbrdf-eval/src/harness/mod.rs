@@ -2,11 +2,13 @@
 //! fold of a [`Mode`], encodes and decodes every evaluation material at every k, and records
 //! each [`Measure`]. PCA, IPCA and DeepBRDF all run through [`run`] unchanged.
 
+mod at_ks;
 mod codec;
 mod measures;
 mod modes;
 mod report;
 
+pub use at_ks::AtKs;
 pub use codec::{Codec, FoldTraining, Method};
 pub use deepbrdf_data::mapping::MedianReference;
 pub use measures::{Measure, Original, Yardstick};
@@ -196,16 +198,25 @@ pub fn run_with_extra(
         // kept in the order material, method, codec, measure.
         let mut per_material: Vec<Vec<Record>> = vec![Vec::new(); fold.test.len()];
         for method in methods {
+            let ks = method.ks(&config.ks);
+            if let Some(k) = ks.iter().find(|k| !config.ks.contains(k)) {
+                return Err(EvalError::Invalid(format!(
+                    "{} asked for k = {k}, which is not among the evaluated k {:?}",
+                    method.name(),
+                    config.ks
+                )));
+            }
+            if ks.is_empty() {
+                continue;
+            }
             let t = Instant::now();
-            let codecs = method.fit_fold(&set, &config.ks, progress)?;
-            if codecs.len() != config.ks.len()
-                || codecs.iter().zip(&config.ks).any(|(c, &k)| c.k() != k)
-            {
+            let codecs = method.fit_fold(&set, &ks, progress)?;
+            if codecs.len() != ks.len() || codecs.iter().zip(&ks).any(|(c, &k)| c.k() != k) {
                 return Err(EvalError::Invalid(format!(
                     "{} returned codecs for k = {:?}, expected {:?}",
                     method.name(),
                     codecs.iter().map(|c| c.k()).collect::<Vec<_>>(),
-                    config.ks
+                    ks
                 )));
             }
             fits.push(FitTiming {
@@ -352,6 +363,37 @@ mod tests {
         for f in ["error_vs_k_mapped_mse.png", "per_material_cos_rmse.svg", "fits.csv"] {
             assert!(dir.path().join(f).is_file(), "{f} missing");
         }
+    }
+
+    #[test]
+    fn a_method_restricted_to_some_k_is_fitted_and_scored_only_there() {
+        let (names, tables) = sparse_set(9);
+        let (pca, ipca) = methods();
+        let config = HarnessConfig {
+            ks: vec![1, 2, 3],
+            mode: Mode::KFold { folds: 3 },
+            seed: 3,
+            measures: vec![Measure::MappedMse],
+        };
+        let data = Materials { names: &names, tables: &tables, label: "synthetic" };
+        let only_2 = AtKs::new(&ipca, &[2, 7]);
+        let results = run(&[&pca, &only_2], &config, data, None, &Silent).unwrap();
+        assert_eq!(results.records.len(), 9 * 3 + 9);
+        assert!(results.mean("IPCA", 1, Measure::MappedMse).is_none());
+        assert!(results.mean("IPCA", 3, Measure::MappedMse).is_none());
+        // The same numbers as an unrestricted run at that k.
+        let full = run(&[&ipca], &config, data, None, &Silent).unwrap();
+        assert_eq!(
+            results.mean("IPCA", 2, Measure::MappedMse),
+            full.mean("IPCA", 2, Measure::MappedMse)
+        );
+        assert!(results.summary_table().contains(" - |"));
+        let dir = tempfile::tempdir().unwrap();
+        results.write(dir.path()).unwrap();
+        // Restricted to no evaluated k at all: the method has no record.
+        let none = AtKs::new(&ipca, &[9]);
+        let results = run(&[&pca, &none], &config, data, None, &Silent).unwrap();
+        assert!(results.records.iter().all(|r| r.method == "PCA"));
     }
 
     /// A method whose codecs refuse to encode any table they were fitted on, and which records

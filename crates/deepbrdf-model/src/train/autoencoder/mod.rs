@@ -16,6 +16,7 @@ pub use config::{saved_config, SliceDropoutConfig, TrainConfig};
 pub(crate) use step::{coefficient_gradients, gradients};
 
 use crate::autoencoder::{legacy, Autoencoder, INPUT_VALUES};
+use deepbrdf_data::layout::PLANE;
 use crate::error::ModelError;
 use crate::train::checkpoint::{self, checkpoint_path};
 use crate::train::log::EpochRecord;
@@ -133,10 +134,15 @@ pub fn evaluate(
         let deviation = model.decode_deviation(model.encode_centred(b.input));
         let batch = chunk.len();
         let diff = deviation * b.mask - b.target; // [batch, 540, 90, 90]
-        let sq = (diff.clone() * diff).reshape([batch, INPUT_VALUES]).sum_dim(1); // [batch, 1]
+        // Summed over one image of the layout on the device, the 540 images of a BRDF in f64
+        // here: one reduction over all 4.4 M values of a BRDF returned 18-56x too little on
+        // wgpu (Mesa's lavapipe), and f32 accumulation over millions of values loses digits.
+        let planes = INPUT_VALUES / PLANE;
+        let sq = (diff.clone() * diff).reshape([batch * planes, PLANE]).sum_dim(1); // [batch * 540, 1]
         let sq = crate::read_back::values(sq, "the squared errors")?;
-        for (s, v) in sq.iter().zip(&b.valid) {
-            errors.push(f64::from(*s) / v.max(1.0));
+        for (per_plane, v) in sq.chunks(planes).zip(&b.valid) {
+            let total: f64 = per_plane.iter().map(|&s| f64::from(s)).sum();
+            errors.push(total / v.max(1.0));
         }
         progress.advance(batch as u64);
     }
