@@ -8,7 +8,7 @@ use crate::data_args::CacheArg;
 use crate::editing::ModelCodec;
 use crate::model_arg::ModelArg;
 use crate::stats::mean;
-use anyhow::{bail, Context};
+use anyhow::Context;
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::dataset::{DataSource, Dataset};
 use deepbrdf_data::files::write_atomic;
@@ -44,6 +44,37 @@ pub struct Args {
     pub cache: CacheArg,
 }
 
+/// IPCA's training data when the model's: the bundled collections of its provenance label
+/// (`merl`, or `merl+nielsen2015+...` as `train --add-collections` writes it), loaded as
+/// `train` loaded them (the added collections' materials named `COLLECTION/NAME`).
+fn model_collections(
+    label: &str,
+    cache: &deepbrdf_data::cache::Cache,
+    progress: &dyn Progress,
+) -> anyhow::Result<Dataset> {
+    let collections = label
+        .split('+')
+        .map(|c| c.parse::<Collection>())
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|_| {
+            anyhow::anyhow!(
+                "the model was trained on '{label}', not bundled collections: give --ipca-data \
+                 DIR with its training materials, so that IPCA is fitted on the same data"
+            )
+        })?;
+    let mut train = Dataset { label: label.to_string(), names: Vec::new(), tables: Vec::new() };
+    for (i, &c) in collections.iter().enumerate() {
+        let set = Dataset::load(&DataSource::Bundled(c), cache, progress)
+            .with_context(|| format!("loading IPCA's training data {}", c.name()))?;
+        match i {
+            0 => train.names.extend(set.names),
+            _ => train.names.extend(set.names.iter().map(|n| format!("{}/{n}", c.name()))),
+        }
+        train.tables.extend(set.tables);
+    }
+    Ok(train)
+}
+
 /// One material's row.
 struct Row {
     material: String,
@@ -56,22 +87,14 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let model = DeepBrdf::load(&args.model.dir()?, &device)?;
     let k = model.k();
     let cache = args.cache.cache();
-    let train_source = match &args.ipca_data {
-        Some(dir) => DataSource::Folder(dir.clone()),
-        None => {
-            let label = &model.provenance().data_label;
-            if label != "merl" {
-                bail!(
-                    "the model was trained on '{label}', not the bundled merl collection: give \
-                     --ipca-data DIR with its training materials, so that IPCA is fitted on the \
-                     same data"
-                );
-            }
-            DataSource::Bundled(Collection::Merl)
+    let train = match &args.ipca_data {
+        Some(dir) => {
+            let source = DataSource::Folder(dir.clone());
+            Dataset::load(&source, &cache, progress)
+                .with_context(|| format!("loading IPCA's training data {}", source.label()))?
         }
+        None => model_collections(&model.provenance().data_label, &cache, progress)?,
     };
-    let train = Dataset::load(&train_source, &cache, progress)
-        .with_context(|| format!("loading IPCA's training data {}", train_source.label()))?;
     let refs: Vec<_> = train.tables.iter().collect();
     let basis = Arc::new(BaselineBasis::fit("IPCA", MappingKind::LogRelative, &refs, k, progress)?);
     let ipca = basis.codec(k)?;
@@ -82,9 +105,27 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     };
     let shown = Dataset::load(&source, &cache, progress)
         .with_context(|| format!("loading the dataset {}", source.label()))?;
-    let seen = shown.names.iter().filter(|n| train.names.contains(n)).count();
-    if seen > 0 {
-        eprintln!("note: {seen} of the shown materials are in IPCA's training data");
+    // Shown materials the representations were fitted to (a model trained with
+    // `--add-collections` names them `COLLECTION/NAME`): then the figure is in-sample.
+    let seen = shown
+        .names
+        .iter()
+        .filter(|n| {
+            train.names.contains(n)
+                || (args.data.is_none()
+                    && train.names.contains(&format!("{}/{n}", args.collection.name())))
+        })
+        .count();
+    let in_sample = (seen > 0).then(|| {
+        format!(
+            "{seen} of the {} shown materials are in the training data of both representations: \
+             in-sample, not Fig. 9's generalization (give --model with a model trained on merl \
+             alone)",
+            shown.len()
+        )
+    });
+    if let Some(note) = &in_sample {
+        eprintln!("note: {note}");
     }
 
     let tonemap = Tonemap::default();
@@ -137,6 +178,9 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let wins = rows.iter().filter(|r| r.deepbrdf < r.ipca).count();
     writeln!(md, "| **mean** | **{d:.4}** | **{i:.4}** |")?;
     writeln!(md, "\nDeepBRDF is below IPCA on {wins} of {} materials.", rows.len())?;
+    if let Some(note) = &in_sample {
+        writeln!(md, "\n**Note**: {note}.")?;
+    }
     write_atomic(&args.out.join("fig9.csv"), csv.as_bytes())?;
     write_atomic(&args.out.join("summary.md"), md.as_bytes())?;
     print!("{md}");
