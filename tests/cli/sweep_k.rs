@@ -49,7 +49,8 @@ fn sweep_k_writes_results_and_reuses_trained_models() {
     tiny_config(&config);
     let readme = dir.path().join("README.md");
     let held_out = "<!-- sweep-k:begin -->\nheld out\n<!-- sweep-k:end -->\n";
-    let in_sample = "<!-- sweep-k-in-sample:begin -->\nstale block\n<!-- sweep-k-in-sample:end -->\n";
+    let in_sample =
+        "<!-- sweep-k-in-sample:begin -->\nstale block\n<!-- sweep-k-in-sample:end -->\n";
     std::fs::write(&readme, format!("# x\n{in_sample}{held_out}end\n")).unwrap();
     let out = dir.path().join("out");
     let readme_arg = readme.to_str().unwrap().to_string();

@@ -52,16 +52,15 @@ fn model_collections(
     cache: &deepbrdf_data::cache::Cache,
     progress: &dyn Progress,
 ) -> anyhow::Result<Dataset> {
-    let collections = label
-        .split('+')
-        .map(|c| c.parse::<Collection>())
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|_| {
-            anyhow::anyhow!(
+    let collections =
+        label.split('+').map(|c| c.parse::<Collection>()).collect::<Result<Vec<_>, _>>().map_err(
+            |_| {
+                anyhow::anyhow!(
                 "the model was trained on '{label}', not bundled collections: give --ipca-data \
                  DIR with its training materials, so that IPCA is fitted on the same data"
             )
-        })?;
+            },
+        )?;
     let mut train = Dataset { label: label.to_string(), names: Vec::new(), tables: Vec::new() };
     for (i, &c) in collections.iter().enumerate() {
         let set = Dataset::load(&DataSource::Bundled(c), cache, progress)

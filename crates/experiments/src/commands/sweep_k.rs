@@ -343,7 +343,9 @@ fn k_list(flag: &str, arg: Option<&str>, among: &[usize]) -> anyhow::Result<Vec<
             .split(',')
             .map(|k| k.trim().parse::<usize>())
             .collect::<Result<Vec<_>, _>>()
-            .map_err(|_| anyhow::anyhow!("{flag} {list:?}: expected `all` or k values such as 10,20"))?,
+            .map_err(|_| {
+                anyhow::anyhow!("{flag} {list:?}: expected `all` or k values such as 10,20")
+            })?,
     };
     if let Some(k) = ks.iter().find(|k| !among.contains(k)) {
         bail!("{flag}: k = {k} is not among {among:?}");

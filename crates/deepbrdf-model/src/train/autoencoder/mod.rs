@@ -16,13 +16,13 @@ pub use config::{saved_config, SliceDropoutConfig, TrainConfig};
 pub(crate) use step::{coefficient_gradients, gradients};
 
 use crate::autoencoder::{legacy, Autoencoder, INPUT_VALUES};
-use deepbrdf_data::layout::PLANE;
 use crate::error::ModelError;
 use crate::train::checkpoint::{self, checkpoint_path};
 use crate::train::log::EpochRecord;
 use crate::train::run::{run, Session};
 use crate::training_set::TrainingSet;
 use batch::batch_tensors;
+use deepbrdf_data::layout::PLANE;
 use step::AutoencoderStep;
 
 /// A trained network and how it was trained.
@@ -134,6 +134,7 @@ pub fn evaluate(
         let deviation = model.decode_deviation(model.encode_centred(b.input));
         let batch = chunk.len();
         let diff = deviation * b.mask - b.target; // [batch, 540, 90, 90]
+
         // Summed over one image of the layout on the device, the 540 images of a BRDF in f64
         // here: one reduction over all 4.4 M values of a BRDF returned 18-56x too little on
         // wgpu (Mesa's lavapipe), and f32 accumulation over millions of values loses digits.
