@@ -9,13 +9,9 @@
 # the 7 real RGL measurements converted exactly (`measured-NAME.binary`): 159 materials.
 # Set EXPERIMENTS to a built binary to skip `cargo run`.
 set -euo pipefail
+out="$(realpath -m "${1:?usage: scripts/all-collections-folder.sh DIR}")"
 cd "$(dirname "$0")/.."
-out="${1:?usage: scripts/all-collections-folder.sh DIR}"
-if [[ -n "${EXPERIMENTS:-}" ]]; then
-    run() { "$EXPERIMENTS" "$@"; }
-else
-    run() { cargo run --release -q -p experiments -- "$@"; }
-fi
+source scripts/experiments.sh
 measured=../shared/data/rgl
 mkdir -p "$out/.collections"
 for c in merl nielsen2015 rgl; do

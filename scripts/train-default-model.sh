@@ -23,13 +23,9 @@
 # trained on `merl` alone), at some cost on MERL materials (0.098 against 0.080).
 # Set EXPERIMENTS to a built binary to skip `cargo run` (e.g. target/release/experiments).
 set -euo pipefail
+work="$(realpath -m "${1:-$(dirname "$0")/../runs/default-model}")"
 cd "$(dirname "$0")/.."
-work="${1:-runs/default-model}"
-if [[ -n "${EXPERIMENTS:-}" ]]; then
-    run() { "$EXPERIMENTS" "$@"; }
-else
-    run() { cargo run --release -q -p experiments -- "$@"; }
-fi
+source scripts/experiments.sh
 add_collections="${ADD_COLLECTIONS-nielsen2015,rgl,rgl-measured}"
 mkdir -p "$work"
 model="$work/default"

@@ -109,17 +109,18 @@ pub fn load_collections(
     Ok(Dataset { label, names, tables })
 }
 
-/// Loads bundled `collections` (through the cache of `data`) as extra training materials, each
-/// named `COLLECTION/NAME` (`train --add-collections`, `baselines --add-collections`); the
-/// label joins the collections' names with `+`.
+/// Loads bundled `collections` (through `cache`) as extra training materials, each named
+/// `COLLECTION/NAME` (`train --add-collections`, `baselines --add-collections`, and
+/// `figures-generalize` fitting IPCA on what such a model saw); the label joins the
+/// collections' names with `+`.
 pub fn load_added(
     collections: &[Collection],
-    data: &DataArgs,
+    cache: &Cache,
     progress: &dyn Progress,
 ) -> anyhow::Result<Dataset> {
     let mut added = Dataset { label: String::new(), names: Vec::new(), tables: Vec::new() };
     for &collection in collections {
-        let more = Dataset::load(&DataSource::Bundled(collection), &data.cache(), progress)
+        let more = Dataset::load(&DataSource::Bundled(collection), cache, progress)
             .with_context(|| format!("loading the collection {}", collection.name()))?;
         added.names.extend(more.names.iter().map(|n| format!("{}/{n}", collection.name())));
         added.tables.extend(more.tables);

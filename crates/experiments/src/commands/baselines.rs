@@ -136,7 +136,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     };
 
     let added = (!args.add_collections.is_empty())
-        .then(|| crate::data_args::load_added(&args.add_collections, &args.data, progress))
+        .then(|| crate::data_args::load_added(&args.add_collections, &args.data.cache(), progress))
         .transpose()?;
     let train_label = format!("{} ({} materials)", train.label, train.len());
     let added_label =

@@ -4,11 +4,11 @@
 //! (eq. 2 then eq. 3) and as IPCA does at the model's k, IPCA fitted on the model's training
 //! data; the image RelAE of each reconstruction under its caption (the harness's measure,
 //! [`ImageRelae`]: the preview sphere, sun and sky).
-use crate::data_args::CacheArg;
+use crate::data_args::{load_added, CacheArg};
 use crate::editing::ModelCodec;
 use crate::model_arg::ModelArg;
 use crate::stats::mean;
-use anyhow::Context;
+use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::dataset::{DataSource, Dataset};
 use deepbrdf_data::files::write_atomic;
@@ -46,31 +46,26 @@ pub struct Args {
 
 /// IPCA's training data when the model's: the bundled collections of its provenance label
 /// (`merl`, or `merl+nielsen2015+...` as `train --add-collections` writes it), loaded as
-/// `train` loaded them (the added collections' materials named `COLLECTION/NAME`).
+/// `train` loaded them (the first as it is, the added ones by [`load_added`]).
 fn model_collections(
     label: &str,
     cache: &deepbrdf_data::cache::Cache,
     progress: &dyn Progress,
 ) -> anyhow::Result<Dataset> {
-    let collections =
-        label.split('+').map(|c| c.parse::<Collection>()).collect::<Result<Vec<_>, _>>().map_err(
-            |_| {
-                anyhow::anyhow!(
-                "the model was trained on '{label}', not bundled collections: give --ipca-data \
-                 DIR with its training materials, so that IPCA is fitted on the same data"
-            )
-            },
-        )?;
-    let mut train = Dataset { label: label.to_string(), names: Vec::new(), tables: Vec::new() };
-    for (i, &c) in collections.iter().enumerate() {
-        let set = Dataset::load(&DataSource::Bundled(c), cache, progress)
-            .with_context(|| format!("loading IPCA's training data {}", c.name()))?;
-        match i {
-            0 => train.names.extend(set.names),
-            _ => train.names.extend(set.names.iter().map(|n| format!("{}/{n}", c.name()))),
-        }
-        train.tables.extend(set.tables);
-    }
+    let parsed: Result<Vec<Collection>, _> = label.split('+').map(str::parse).collect();
+    let Ok(collections) = parsed else {
+        bail!(
+            "the model was trained on '{label}', not bundled collections: give --ipca-data DIR \
+             with its training materials, so that IPCA is fitted on the same data"
+        );
+    };
+    let source = DataSource::Bundled(collections[0]);
+    let mut train = Dataset::load(&source, cache, progress)
+        .with_context(|| format!("loading IPCA's training data {}", source.label()))?;
+    let added = load_added(&collections[1..], cache, progress)?;
+    train.names.extend(added.names);
+    train.tables.extend(added.tables);
+    train.label = label.to_string();
     Ok(train)
 }
 

@@ -260,6 +260,7 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
     let wall = started.elapsed().as_secs_f64();
     let report = Report {
         results: &results,
+        deep_ks: &deep_ks,
         robustness: &robustness,
         fits: &fits,
         training: &training,
@@ -359,6 +360,8 @@ fn k_list(flag: &str, arg: Option<&str>, among: &[usize]) -> anyhow::Result<Vec<
 /// Everything the summaries are made of.
 struct Report<'a> {
     results: &'a Results,
+    /// The k DeepBRDF was trained and scored at.
+    deep_ks: &'a [usize],
     robustness: &'a Robustness,
     fits: &'a [FitRecord],
     training: &'a str,
@@ -375,14 +378,7 @@ impl Report<'_> {
     fn claims(&self) -> String {
         let mut s = String::new();
         let m = |method: &str, k: usize, measure| self.results.mean(method, k, measure);
-        let deep_ks: Vec<usize> = self
-            .results
-            .ks
-            .iter()
-            .copied()
-            .filter(|&k| m(NAME, k, self.results.measures[0]).is_some())
-            .collect();
-        let Some(&k0) = deep_ks.iter().find(|&&k| k == 10).or(deep_ks.first()) else {
+        let Some(&k0) = self.deep_ks.iter().find(|&&k| k == 10).or(self.deep_ks.first()) else {
             return s;
         };
         let mut measures = self.results.measures.clone();

@@ -142,7 +142,8 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     };
     let mut data = args.data.load(progress)?;
     if !args.add_collections.is_empty() {
-        let more = crate::data_args::load_added(&args.add_collections, &args.data, progress)?;
+        let more =
+            crate::data_args::load_added(&args.add_collections, &args.data.cache(), progress)?;
         data.label = format!("{}+{}", data.label, more.label);
         data.names.extend(more.names);
         data.tables.extend(more.tables);
