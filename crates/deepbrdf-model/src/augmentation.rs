@@ -6,13 +6,19 @@
 //!   the 5 other orders of its colour channels, `rho'_c = rho_pi(c)`.
 //! - Pairwise interpolation (AugMERL, NeuMaDiff): `rho = t rho_a + (1 - t) rho_b` for pairs
 //!   (a, b) and weights t in [1/4, 3/4] drawn from the seed, valid where both are.
+//! - Darker or lighter diffuse floors: `rho'_c = max(rho_c - (1 - s) d_c, 0)` for a BRDF and
+//!   channel order drawn from the seed, `d_c` its channel's diffuse floor (the
+//!   [`FLOOR_QUANTILE`] quantile of its valid values) and `s` log-uniform in [`FLOOR_SCALES`]:
+//!   a Lambertian BRDF is scaled by `s`, a highlight keeps its height above the floor (dark
+//!   dielectrics such as black-obsidian are bright specular lobes on a near-black floor).
 //!
-//! Sample `i < n` is BRDF i itself; the permutations follow (5 per BRDF), then the mixtures.
+//! Sample `i < n` is BRDF i itself; the permutations follow (5 per BRDF), then the mixtures,
+//! then the floor-scaled BRDFs.
 
-use burn::config::Config;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
 use crate::autoencoder::INPUT_VALUES;
 use crate::error::ModelError;
@@ -25,16 +31,22 @@ const PERMUTATIONS: [[usize; 3]; 6] =
     [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
 /// Values of one colour image of the layout.
 const IMAGE: usize = INPUT_VALUES / (3 * N_PHI_D);
+/// The quantile of a channel's valid linear values taken as its diffuse floor.
+pub const FLOOR_QUANTILE: f64 = 0.1;
+/// The range of a floor's scale `s` (drawn log-uniformly).
+pub const FLOOR_SCALES: (f64, f64) = (1.0 / 16.0, 1.5);
 
-/// Which extra BRDFs a training set is augmented with.
-#[derive(Config, Debug, PartialEq)]
+/// Which extra BRDFs a training set is augmented with. Every field has a default (none), so a
+/// configuration written before a field existed still loads.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct AugmentationConfig {
     /// Add every BRDF in the 5 other orders of its colour channels.
-    #[config(default = false)]
     pub rgb_permutations: bool,
     /// Pairwise mixtures in linear BRDF space per training BRDF (rounded down; 0: none).
-    #[config(default = 0.0)]
     pub mixtures_per_brdf: f64,
+    /// BRDFs with a scaled diffuse floor per training BRDF (rounded down; 0: none).
+    pub floors_per_brdf: f64,
 }
 
 /// One augmented sample.
@@ -46,9 +58,32 @@ pub enum Sample {
     Permuted { index: usize, order: usize },
     /// `t a + (1 - t) b`.
     Mixture { a: usize, b: usize, t: f64 },
+    /// BRDF `index` with its channels in order `PERMUTATIONS[order]` and its diffuse floor
+    /// scaled by `scale`.
+    Floor { index: usize, order: usize, scale: f64 },
 }
 
 impl AugmentationConfig {
+    /// No augmentation.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// With or without the channel permutations.
+    pub fn with_rgb_permutations(self, rgb_permutations: bool) -> Self {
+        Self { rgb_permutations, ..self }
+    }
+
+    /// With this many mixtures per BRDF.
+    pub fn with_mixtures_per_brdf(self, mixtures_per_brdf: f64) -> Self {
+        Self { mixtures_per_brdf, ..self }
+    }
+
+    /// With this many floor-scaled BRDFs per BRDF.
+    pub fn with_floors_per_brdf(self, floors_per_brdf: f64) -> Self {
+        Self { floors_per_brdf, ..self }
+    }
+
     /// The `slice` preset's: permutations and 4 mixtures per BRDF.
     pub fn preset() -> Self {
         Self::new().with_rgb_permutations(true).with_mixtures_per_brdf(4.0)
@@ -56,18 +91,21 @@ impl AugmentationConfig {
 
     /// Checks the settings.
     pub fn validate(&self) -> crate::error::Result<()> {
-        if !(0.0..=100.0).contains(&self.mixtures_per_brdf) {
-            return Err(ModelError::Invalid(format!(
-                "{} mixtures per BRDF is out of range (0 to 100)",
-                self.mixtures_per_brdf
-            )));
+        for (what, count) in
+            [("mixtures", self.mixtures_per_brdf), ("floor-scaled BRDFs", self.floors_per_brdf)]
+        {
+            if !(0.0..=100.0).contains(&count) {
+                return Err(ModelError::Invalid(format!(
+                    "{count} {what} per BRDF is out of range (0 to 100)"
+                )));
+            }
         }
         Ok(())
     }
 
     /// Whether no sample is added.
     pub fn is_none(&self) -> bool {
-        !self.rgb_permutations && self.mixtures(usize::MAX / 1024) == 0
+        self.samples(usize::MAX / 1024) == usize::MAX / 1024
     }
 
     fn mixtures(&self, n: usize) -> usize {
@@ -77,10 +115,21 @@ impl AugmentationConfig {
         (self.mixtures_per_brdf * n as f64).floor() as usize
     }
 
+    fn floors(&self, n: usize) -> usize {
+        (self.floors_per_brdf * n as f64).floor() as usize
+    }
+
+    fn permuted(&self, n: usize) -> usize {
+        if self.rgb_permutations {
+            5 * n
+        } else {
+            0
+        }
+    }
+
     /// The number of samples of a set of `n` BRDFs, originals included.
     pub fn samples(&self, n: usize) -> usize {
-        let permuted = if self.rgb_permutations { 5 * n } else { 0 };
-        n + permuted + self.mixtures(n)
+        n + self.permuted(n) + self.mixtures(n) + self.floors(n)
     }
 
     /// Sample `i` of a set of `n` BRDFs (`i < samples(n)`), drawn from `seed`.
@@ -92,7 +141,17 @@ impl AugmentationConfig {
         if self.rgb_permutations && j < 5 * n {
             return Sample::Permuted { index: j / 5, order: 1 + j % 5 };
         }
-        let j = if self.rgb_permutations { j - 5 * n } else { j };
+        let j = j - self.permuted(n);
+        if j >= self.mixtures(n) {
+            let j = j - self.mixtures(n);
+            let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0xf100_5ca1_u64);
+            rng.set_stream(j as u64);
+            let index = rng.random_range(0..n);
+            let order = if self.rgb_permutations { rng.random_range(0..6) } else { 0 };
+            let (lo, hi) = FLOOR_SCALES;
+            let scale = (lo.ln() + rng.random_range(0.0..1.0) * (hi / lo).ln()).exp();
+            return Sample::Floor { index, order, scale };
+        }
         let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0xa06_3e71_u64);
         rng.set_stream(j as u64);
         let a = rng.random_range(0..n);
@@ -120,16 +179,25 @@ pub fn sample_layout(data: &TrainingSet, sample: Sample) -> crate::error::Result
     };
     let valid = match sample {
         Sample::Original(_) => unreachable!("returned above"),
-        Sample::Permuted { index, order } => {
+        Sample::Permuted { index, order } | Sample::Floor { index, order, .. } => {
             let (x, mask) = (data.input(index), data.mask(index));
             let perm = PERMUTATIONS[order];
+            let floors = match sample {
+                Sample::Floor { scale, .. } => {
+                    diffuse_floors(data, index, reference).map(|d| (1.0 - scale) * d)
+                }
+                _ => [0.0; 3],
+            };
             out.par_chunks_mut(IMAGE).enumerate().for_each(|(image, o)| {
                 let (slice, colour) = (image / 3, image % 3);
                 let from = (slice * 3 + perm[colour]) * IMAGE;
                 let to = image * IMAGE;
+                let lowered = floors[perm[colour]];
                 for (c, v) in o.iter_mut().enumerate() {
                     if mask[to + c] != 0.0 {
-                        *v = map(unmap(x[from + c], reference[from + c]), reference[to + c]);
+                        let rho = unmap(x[from + c], reference[from + c]);
+                        let rho = if lowered == 0.0 { rho } else { (rho - lowered).max(0.0) };
+                        *v = map(rho, reference[to + c]);
                     }
                 }
             });
@@ -152,6 +220,26 @@ pub fn sample_layout(data: &TrainingSet, sample: Sample) -> crate::error::Result
         }
     };
     Ok((out, valid))
+}
+
+/// The diffuse floor of each colour channel of BRDF `index`: the [`FLOOR_QUANTILE`] quantile of
+/// the channel's valid linear values (0 where a channel has none).
+fn diffuse_floors(data: &TrainingSet, index: usize, reference: &[f32]) -> [f64; 3] {
+    let (x, mask) = (data.input(index), data.mask(index));
+    std::array::from_fn(|colour| {
+        let mut values: Vec<f64> = (0..N_PHI_D)
+            .flat_map(|slice| {
+                let start = (slice * 3 + colour) * IMAGE;
+                (start..start + IMAGE).filter(|&i| mask[i] != 0.0)
+            })
+            .map(|i| inverse_log_relative(f64::from(x[i]), f64::from(reference[i])).max(0.0))
+            .collect();
+        if values.is_empty() {
+            return 0.0;
+        }
+        let at = ((values.len() - 1) as f64 * FLOOR_QUANTILE) as usize;
+        *values.select_nth_unstable_by(at, f64::total_cmp).1
+    })
 }
 
 #[cfg(test)]
@@ -216,5 +304,40 @@ mod tests {
         )
         .unwrap();
         assert!(sample_layout(&no_reference, Sample::Permuted { index: 0, order: 1 }).is_err());
+    }
+
+    #[test]
+    fn floor_samples_lower_each_channel_by_its_quantile_and_keep_the_rest() {
+        let config =
+            AugmentationConfig::new().with_rgb_permutations(true).with_floors_per_brdf(2.0);
+        assert_eq!(config.samples(3), 3 + 15 + 6);
+        assert!(!config.is_none());
+        for i in 18..24 {
+            let Sample::Floor { index, order, scale } = config.sample(3, i, 7) else {
+                panic!("sample {i} is a floor sample")
+            };
+            assert!(index < 3 && order < 6, "{index} {order}");
+            assert!((FLOOR_SCALES.0..=FLOOR_SCALES.1).contains(&scale), "{scale}");
+        }
+        let data = set();
+        let reference = data.reference_layout().unwrap().to_vec();
+        let floors = diffuse_floors(&data, 1, &reference);
+        // Table b's channels are 3v, v, v/2 with v >= 0.2: floors in that order, above 0.1.
+        assert!(floors[0] > floors[1] && floors[1] > floors[2] && floors[2] > 0.1, "{floors:?}");
+        let scale = 0.25;
+        let (lowered, valid) =
+            sample_layout(&data, Sample::Floor { index: 1, order: 0, scale }).unwrap();
+        assert_eq!(valid, data.valid_values(1));
+        let linear =
+            |x: &[f32], i: usize| inverse_log_relative(f64::from(x[i]), f64::from(reference[i]));
+        let mut clamped = 0;
+        for i in (0..INPUT_VALUES).filter(|&i| data.mask(1)[i] != 0.0).step_by(997) {
+            let colour = (i / IMAGE) % 3;
+            let want = (linear(data.input(1), i) - (1.0 - scale) * floors[colour]).max(0.0);
+            clamped += usize::from(want == 0.0);
+            assert!((linear(&lowered, i) - want).abs() < 1e-5, "value {i}");
+        }
+        assert!(clamped == 0, "no valid value of b lies below 3/4 of its floor");
+        assert!(AugmentationConfig::new().with_floors_per_brdf(101.0).validate().is_err());
     }
 }
