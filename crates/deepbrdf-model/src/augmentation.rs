@@ -138,27 +138,31 @@ impl AugmentationConfig {
             return Sample::Original(i);
         }
         let j = i - n;
-        if self.rgb_permutations && j < 5 * n {
+        if j < self.permuted(n) {
             return Sample::Permuted { index: j / 5, order: 1 + j % 5 };
         }
         let j = j - self.permuted(n);
-        if j >= self.mixtures(n) {
-            let j = j - self.mixtures(n);
-            let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0xf100_5ca1_u64);
-            rng.set_stream(j as u64);
-            let index = rng.random_range(0..n);
-            let order = if self.rgb_permutations { rng.random_range(0..6) } else { 0 };
-            let (lo, hi) = FLOOR_SCALES;
-            let scale = (lo.ln() + rng.random_range(0.0..1.0) * (hi / lo).ln()).exp();
-            return Sample::Floor { index, order, scale };
+        if j < self.mixtures(n) {
+            let mut rng = stream(seed ^ 0xa06_3e71_u64, j);
+            let a = rng.random_range(0..n);
+            let b = (a + rng.random_range(1..n)) % n;
+            let t = rng.random_range(0.25..0.75);
+            return Sample::Mixture { a, b, t };
         }
-        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0xa06_3e71_u64);
-        rng.set_stream(j as u64);
-        let a = rng.random_range(0..n);
-        let b = (a + rng.random_range(1..n)) % n;
-        let t = rng.random_range(0.25..0.75);
-        Sample::Mixture { a, b, t }
+        let mut rng = stream(seed ^ 0xf100_5ca1_u64, j - self.mixtures(n));
+        let index = rng.random_range(0..n);
+        let order = if self.rgb_permutations { rng.random_range(0..6) } else { 0 };
+        let (lo, hi) = FLOOR_SCALES;
+        let scale = (lo.ln() + rng.random_range(0.0..1.0) * (hi / lo).ln()).exp();
+        Sample::Floor { index, order, scale }
     }
+}
+
+/// The generator of the `j`-th sample of one kind (`seed` already salted by the kind).
+fn stream(seed: u64, j: usize) -> ChaCha8Rng {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(j as u64);
+    rng
 }
 
 /// The mapped layout (invalid cells 0) and the number of valid values of `sample` of `data`.
