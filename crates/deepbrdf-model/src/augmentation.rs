@@ -36,8 +36,9 @@ pub const FLOOR_QUANTILE: f64 = 0.1;
 /// The range of a floor's scale `s` (drawn log-uniformly).
 pub const FLOOR_SCALES: (f64, f64) = (1.0 / 16.0, 1.5);
 
-/// Which extra BRDFs a training set is augmented with. Every field has a default (none), so a
-/// configuration written before a field existed still loads.
+/// Which extra BRDFs a training set is augmented with, and how its samples weigh in the loss.
+/// Every field has a default (none), so a configuration written before a field existed still
+/// loads.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct AugmentationConfig {
@@ -47,6 +48,9 @@ pub struct AugmentationConfig {
     pub mixtures_per_brdf: f64,
     /// BRDFs with a scaled diffuse floor per training BRDF (rounded down; 0: none).
     pub floors_per_brdf: f64,
+    /// P of the image-space weighting of each sample's colour channels in the training loss
+    /// ([`crate::loss::colour_weights`]; 0: eq. (4)'s unweighted error).
+    pub image_weight_power: f64,
 }
 
 /// One augmented sample.
@@ -84,6 +88,11 @@ impl AugmentationConfig {
         Self { floors_per_brdf, ..self }
     }
 
+    /// With the image-space weighting of power `image_weight_power`.
+    pub fn with_image_weight_power(self, image_weight_power: f64) -> Self {
+        Self { image_weight_power, ..self }
+    }
+
     /// The `slice` preset's: permutations and 4 mixtures per BRDF.
     pub fn preset() -> Self {
         Self::new().with_rgb_permutations(true).with_mixtures_per_brdf(4.0)
@@ -99,6 +108,12 @@ impl AugmentationConfig {
                     "{count} {what} per BRDF is out of range (0 to 100)"
                 )));
             }
+        }
+        if !(0.0..=2.0).contains(&self.image_weight_power) {
+            return Err(ModelError::Invalid(format!(
+                "image weight power {} is out of range (0 to 2)",
+                self.image_weight_power
+            )));
         }
         Ok(())
     }

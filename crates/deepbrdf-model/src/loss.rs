@@ -4,8 +4,16 @@
 //! Eq. (4) sums `||mask(g(f(X))) - mask(X)||` over the training set; we use the mean over valid
 //! values of the squared difference, which has the same minimiser, keeps the learning rate
 //! independent of the batch size, and equals the mapped-space MSE the evaluation reports.
+//!
+//! [`colour_weights`] weighs a training sample's colour channels in that error by how much a
+//! mapped error moves a rendering of the sample, relative to the rendering's brightness (issue
+//! 13; not in the paper): the image-space RelAE the evaluation reports.
 
 use burn::prelude::*;
+use deepbrdf_data::layout::layout_index;
+use deepbrdf_data::mapping::EPSILON;
+use deepbrdf_data::merl::grid::cos_weights;
+use deepbrdf_data::merl::{cell_index, N_PHI_D, N_THETA_D, N_THETA_H};
 
 /// Mean squared error over the cells where `mask` is 1 (eq. 4, L2).
 ///
@@ -40,6 +48,51 @@ pub fn masked_mse_centred(
     (diff.clone() * diff).sum().div_scalar(valid.max(1.0)) // [1]
 }
 
+/// The image-space weights `(S_c / R)^(2 power)` of the three colour channels of a mapped layout
+/// (`540 * 90 * 90` values, invalid cells 0; `reference`: eq. (1)'s reference in layout order).
+///
+/// Eq. (1) has slope `d rho / d rho' = rho + rho_ref + 2 eps = (rho_ref + eps) e^rho'`: a mapped
+/// error `delta` in a cell moves the cosine-weighted radiance a rendering sees there by about
+/// `delta (rho_ref + eps) e^rho' cos theta_i cos theta_o`. `S_c` sums that sensitivity over the
+/// valid cells of channel c, `R` the cosine-weighted linear values `rho + eps` over all three
+/// channels (divided by 3): a uniform mapped error `delta` moves the rendering by about
+/// `delta S_c / R` of its brightness. A dark material (`rho` far below the median reference) has
+/// a large ratio (its RelAE is large for a mapped error that is small), a bright one a ratio
+/// near 1. Cells are valid where their cosine product is positive and their mapped value is not
+/// exactly 0 (invalid cells are 0; a valid value is 0 only for `rho = -eps`). Power 0 gives 1.
+pub fn colour_weights(layout: &[f32], reference: &[f32], power: f64) -> [f64; 3] {
+    if power == 0.0 {
+        return [1.0; 3];
+    }
+    let cos = cos_weights();
+    let (mut sensitivity, mut brightness) = ([0f64; 3], 0f64);
+    for h in 0..N_THETA_H {
+        for d in 0..N_THETA_D {
+            for p in 0..N_PHI_D {
+                let weight = f64::from(cos[cell_index(h, d, p)]);
+                if weight <= 0.0 {
+                    continue;
+                }
+                for c in 0..3 {
+                    let i = layout_index(h, d, p, c);
+                    if layout[i] == 0.0 {
+                        continue;
+                    }
+                    let scale = f64::from(reference[i]) + EPSILON;
+                    let grown = f64::from(layout[i]).exp();
+                    sensitivity[c] += weight * scale * grown;
+                    brightness += weight * scale * (grown - 1.0);
+                }
+            }
+        }
+    }
+    let brightness = brightness / 3.0;
+    sensitivity.map(|s| match brightness > 0.0 && s > 0.0 {
+        true => (s / brightness).powf(2.0 * power),
+        false => 1.0,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -69,6 +122,33 @@ mod tests {
             masked_mse_centred(dev, (x - mu) * mask.clone(), mask, f64::from(valid)).into_scalar();
         assert!(plain > 0.1, "{plain}");
         assert!((plain - centred).abs() <= 1e-5 * plain.abs(), "{plain} vs {centred}");
+    }
+
+    #[test]
+    fn colour_weights_grow_as_a_channel_darkens_against_the_reference() {
+        use deepbrdf_data::layout::{LAYOUT_VALUES, PLANE};
+        use deepbrdf_data::mapping::log_relative;
+        // rho = rho_ref in all channels: S_c = 2 R (the slope is 2 (rho + eps)) for every c.
+        let reference = vec![0.1f32; LAYOUT_VALUES];
+        let even = vec![log_relative(0.1, 0.1) as f32; LAYOUT_VALUES];
+        for w in colour_weights(&even, &reference, 0.5) {
+            assert!((w - 2.0).abs() < 1e-6, "{w}");
+        }
+        assert_eq!(colour_weights(&even, &reference, 0.0), [1.0; 3]);
+        // A material 10 x darker than the reference in every channel: the ratio is
+        // (rho + rho_ref + 2 eps) / (rho + eps) = 0.112 / 0.011.
+        let dark = vec![log_relative(0.01, 0.1) as f32; LAYOUT_VALUES];
+        let want = 0.112 / 0.011;
+        for w in colour_weights(&dark, &reference, 0.5) {
+            assert!((w / want - 1.0).abs() < 1e-4, "{w} vs {want}");
+        }
+        // Power 1 squares it; invalid (zero) cells do not count (here one phi_d slice, all three
+        // channels, so the ratio stays).
+        let mut holed = dark.clone();
+        holed[..3 * PLANE].fill(0.0);
+        for w in colour_weights(&holed, &reference, 1.0) {
+            assert!((w / (want * want) - 1.0).abs() < 1e-3, "{w}");
+        }
     }
 
     #[test]

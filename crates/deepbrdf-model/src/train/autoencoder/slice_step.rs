@@ -20,6 +20,7 @@ use super::batch::{centre, filled_input};
 use crate::augmentation::sample_layout;
 use crate::autoencoder::{Autoencoder, SliceConfig, INPUT_VALUES};
 use crate::error::ModelError;
+use crate::loss::colour_weights;
 use crate::slice_basis::{basis_t, fit_components, fit_slice_basis, project};
 use crate::train::run::on_device;
 use crate::training_set::TrainingSet;
@@ -35,6 +36,9 @@ pub(crate) struct SliceFit {
     residuals: Vec<f64>,
     /// Valid values of each sample.
     valid: Vec<f64>,
+    /// With the image-space weighting: each sample's colour-channel weights in the loss
+    /// ([`colour_weights`], scaled to mean 1 over the samples and channels).
+    weights: Option<Vec<[f32; 3]>>,
     /// With slice dropout: the coefficients of the filled inputs of the BRDFs (not of the
     /// augmentations), `[brdf][selection][540 * M]`.
     pub(crate) filled: Option<Vec<Vec<Vec<f32>>>>,
@@ -70,6 +74,17 @@ pub(crate) fn prepare(
     let samples = augmentation.samples(n);
     let (mut targets, mut residuals, mut valid) =
         (Vec::with_capacity(samples), Vec::with_capacity(samples), Vec::with_capacity(samples));
+    let power = augmentation.image_weight_power;
+    let reference = match power > 0.0 {
+        true => Some(data.reference_layout().ok_or_else(|| {
+            ModelError::Invalid(format!(
+                "{}: the image-space weighting needs the eq. (1) reference of the set",
+                data.label()
+            ))
+        })?),
+        false => None,
+    };
+    let mut weights = Vec::with_capacity(if reference.is_some() { samples } else { 0 });
     progress.start(samples as u64, "projecting the training BRDFs and their augmentations");
     let indices: Vec<usize> = (0..samples).collect();
     for group in indices.chunks(PROJECTED_AT_ONCE) {
@@ -78,6 +93,9 @@ pub(crate) fn prepare(
             .map(|&i| sample_layout(data, augmentation.sample(n, i, seed)))
             .collect::<crate::error::Result<Vec<_>>>()?;
         let layouts: Vec<&[f32]> = made.iter().map(|(l, _)| l.as_slice()).collect();
+        if let Some(r) = reference {
+            weights.extend(layouts.iter().map(|l| colour_weights(l, r, power)));
+        }
         for ((a, r), (_, count)) in project(&layouts, &bt)?.into_iter().zip(&made) {
             targets.push(a);
             residuals.push(r);
@@ -86,6 +104,19 @@ pub(crate) fn prepare(
         progress.advance(group.len() as u64);
     }
     progress.finish();
+    let weights = reference.map(|_| normalised(weights));
+    if let Some(weights) = &weights {
+        let mut all: Vec<f32> = weights.iter().flatten().copied().collect();
+        all.sort_by(f32::total_cmp);
+        let at = |q: f64| all[((all.len() - 1) as f64 * q) as usize];
+        progress.status(&format!(
+            "image-space colour weights (power {power}): min {:.3}, median {:.3}, 90% {:.3}, max {:.3}",
+            at(0.0),
+            at(0.5),
+            at(0.9),
+            at(1.0)
+        ));
+    }
     progress.status(&format!("fitting {} principal components", layers.components));
     let components = fit_components(&targets, layers.components)?;
     let mut model = model;
@@ -113,12 +144,21 @@ pub(crate) fn prepare(
         }
         None => None,
     };
-    Ok((model, SliceFit { targets, residuals, valid, filled }))
+    Ok((model, SliceFit { targets, residuals, valid, weights, filled }))
 }
 
-/// The eq. (4) loss of the samples `indices` (their coefficients' squared error plus their
-/// residuals, over their valid values) and its gradients; `inputs` are the encoder's input
-/// coefficients, the targets' or those of filled inputs.
+/// `weights` scaled to mean 1 over all samples and channels.
+fn normalised(weights: Vec<[f64; 3]>) -> Vec<[f32; 3]> {
+    let count = (3 * weights.len()).max(1) as f64;
+    let mean = weights.iter().flatten().sum::<f64>() / count;
+    let scale = if mean.is_finite() && mean > 0.0 { 1.0 / mean } else { 1.0 };
+    weights.iter().map(|w| w.map(|v| (v * scale) as f32)).collect()
+}
+
+/// The eq. (4) loss of the samples `indices` (their coefficients' squared error, each colour
+/// channel's times its weight, plus their residuals, over their valid values) and its
+/// gradients; `inputs` are the encoder's input coefficients, the targets' or those of filled
+/// inputs.
 pub(crate) fn slice_gradients(
     model: &Autoencoder,
     fit: &SliceFit,
@@ -137,7 +177,22 @@ pub(crate) fn slice_gradients(
     let target = Tensor::<2>::from_data(TensorData::new(targets, [b, len]), device);
     let input = Tensor::<2>::from_data(TensorData::new(inputs, [b, len]), device);
     let diff = net.decode_coefficients(net.encode_coefficients(input)) - target; // [batch, 540 M]
-    let loss = (diff.clone() * diff).sum().div_scalar(valid.max(1.0)); // [1]
+    let squared = diff.clone() * diff; // [batch, 540 M]
+    let squared = match &fit.weights {
+        Some(weights) => {
+            let m = net.directions();
+            let values: Vec<f32> = indices
+                .iter()
+                .flat_map(|&i| {
+                    let w = weights[i];
+                    (0..len).map(move |j| w[(j / m) % 3]) // coefficient j: image j / M
+                })
+                .collect();
+            squared * Tensor::<2>::from_data(TensorData::new(values, [b, len]), device)
+        }
+        None => squared,
+    };
+    let loss = squared.sum().div_scalar(valid.max(1.0)); // [1]
     let value: f32 = loss.clone().into_scalar();
     let value = value + (residual / valid.max(1.0)) as f32;
     Ok((value, on_device(GradientsParams::from_grads(loss.backward(), model), device)))

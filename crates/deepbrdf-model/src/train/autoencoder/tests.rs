@@ -351,4 +351,53 @@ fn slice_training_on_coefficients_matches_the_full_loss_and_resumes() {
     let other = tempfile::tempdir().unwrap();
     let err = train(&augmented, &set, other.path(), false, &Silent, &device()).unwrap_err();
     assert!(err.to_string().contains("reference"), "{err}");
+    // So does the image-space weighting of the loss.
+    let mut weighted = slice_config(1);
+    if let crate::autoencoder::Architecture::Slice(s) = &mut weighted.model.architecture {
+        s.augmentation =
+            crate::augmentation::AugmentationConfig::new().with_image_weight_power(0.5);
+    }
+    let err = train(&weighted, &set, other.path(), false, &Silent, &device()).unwrap_err();
+    assert!(err.to_string().contains("image-space weighting"), "{err}");
+}
+
+#[test]
+fn the_image_space_weighting_favours_the_dark_material() {
+    use crate::augmentation::AugmentationConfig;
+    use deepbrdf_data::mapping::MedianReference;
+    use deepbrdf_data::MerlTable;
+    // Two materials unlike each other: one dark (1/20 of the reference), one bright. A network
+    // with k = 1 cannot fit both; weighting the loss by image-space sensitivity gives the dark
+    // one's error more weight than eq. (4) does, so its error ends lower, and lower relative to
+    // the bright one's.
+    let dark = MerlTable::from_fn(|h, d, _| {
+        let v = 0.004 + 0.0004 * (h as f32 - d as f32).abs();
+        [v, 1.5 * v, 0.7 * v]
+    });
+    let bright = MerlTable::from_fn(|h, _, p| {
+        let v = 0.3 + 0.004 * h as f32 + 0.0003 * p as f32;
+        [2.0 * v, v, 0.5 * v]
+    });
+    let middle = MerlTable::from_fn(|_, d, _| {
+        let v = 0.08 + 0.001 * d as f32;
+        [v, v, v]
+    });
+    let tables = [&dark, &bright, &middle];
+    let reference = MedianReference::from_tables(&tables).unwrap();
+    let names = ["dark".into(), "bright".into(), "middle".into()];
+    let set = TrainingSet::from_tables("t", &names, &tables, &reference).unwrap();
+    let run = |power: f64| {
+        let mut config = slice_config(40);
+        if let crate::autoencoder::Architecture::Slice(s) = &mut config.model.architecture {
+            s.augmentation = AugmentationConfig::new().with_image_weight_power(power);
+        }
+        let dir = tempfile::tempdir().unwrap();
+        train(&config, &set, dir.path(), false, &Silent, &device()).unwrap().per_material_mse
+    };
+    let (plain, weighted) = (run(0.0), run(0.5));
+    assert!(weighted[0] < plain[0], "dark: {} weighted vs {} plain", weighted[0], plain[0]);
+    assert!(
+        weighted[0] / weighted[1] < plain[0] / plain[1],
+        "dark/bright: {weighted:?} weighted vs {plain:?} plain"
+    );
 }
