@@ -61,7 +61,7 @@ fn baselines_in_sample_writes_results_and_bases_and_protects_them() {
         "results.csv",
         "summary.md",
         "fits.csv",
-        "error_vs_k_mapped_mse.png",
+        "error_vs_k_mapped_mse.svg",
         "per_material_cos_rmse.svg",
     ] {
         assert!(dir.path().join("res").join(f).is_file(), "{f} missing");

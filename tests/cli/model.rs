@@ -180,3 +180,29 @@ fn the_configurations_in_configs_load_and_differ_from_the_slice_preset_only_in_i
     }
     assert!(seen >= 2, "configs/ holds the ablation configurations");
 }
+
+#[test]
+fn train_within_a_time_limit_writes_the_epochs_done_and_resumes_to_the_end() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = util::write_data(dir.path(), 3);
+    let config = util::tiny_config(dir.path());
+    let run = dir.path().join("run");
+    let args = ["train", "--config", &s(&config), "--data", &s(&data), "--out", &s(&run)];
+    // Any epoch ends past a limit of a millisecond: one epoch of the two, a model, a checkpoint.
+    let out = util::run_in(dir.path(), &[&args[..], &["--time-limit", "0.001"]].concat());
+    assert!(out.status.success(), "{}", util::stderr(&out));
+    let text = util::stdout(&out);
+    assert!(text.contains("stopped at the time limit after 1 of 2 epochs"), "{text}");
+    let model: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(run.join("model").join("model.json")).unwrap())
+            .unwrap();
+    assert_eq!(model["provenance"]["epochs"], 1, "{model}");
+    let out = util::run_in(dir.path(), &["train", "--resume", &s(&run), "--data", &s(&data)]);
+    assert!(out.status.success(), "{}", util::stderr(&out));
+    assert!(util::stdout(&out).contains("trained 2 epochs"), "{}", util::stdout(&out));
+    for bad in ["0", "-1", "soon"] {
+        let limit = format!("--time-limit={bad}");
+        let out = util::run_in(dir.path(), &[&args[..], &[limit.as_str()]].concat());
+        util::assert_clean_failure(&out, "--time-limit");
+    }
+}

@@ -187,7 +187,7 @@ fn render_set_train_recovery_and_recover_chain() {
     }
     let csv = std::fs::read_to_string(figures.join("per_image.csv")).unwrap();
     assert_eq!(csv.lines().count(), 4, "{csv}");
-    for f in ["fig16.png", "per_material_held-out.png"] {
+    for f in ["fig16.png", "per_material_held-out.svg"] {
         assert!(figures.join(f).is_file(), "{f}: {}", util::stderr(&out));
     }
     // A test set that shares materials with the training set is not held out.

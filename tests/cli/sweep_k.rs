@@ -65,12 +65,9 @@ fn sweep_k_writes_results_and_reuses_trained_models() {
     for f in [
         "results.csv",
         "summary.md",
-        "error_vs_k_mapped_mse.png",
         "error_vs_k_mapped_mse.svg",
-        "per_material_mapped_mse.png",
         "per_material_mapped_mse.svg",
         "robustness.csv",
-        "robustness.png",
         "robustness.svg",
         "fig2_slices.png",
         "training.csv",
@@ -83,7 +80,7 @@ fn sweep_k_writes_results_and_reuses_trained_models() {
     // 3 methods x 2 k x 3 materials x 3 measures (mapped, cosine-weighted, image RelAE), plus
     // the header.
     assert_eq!(results.lines().count(), 1 + 3 * 2 * 3 * 3, "{results}");
-    assert!(out.join("per_material_image_relae.png").is_file());
+    assert!(out.join("per_material_image_relae.svg").is_file());
     let training = std::fs::read_to_string(out.join("training.csv")).unwrap();
     assert_eq!(training.lines().filter(|l| l.contains(",trained,")).count(), 2, "{training}");
     let first_training = training;
@@ -100,7 +97,7 @@ fn sweep_k_writes_results_and_reuses_trained_models() {
     assert!(md.contains("**In-sample**"), "{md}");
     assert!(
         md.contains("| IPCA |")
-            && md.contains("out/error_vs_k_mapped_mse.png")
+            && md.contains("out/error_vs_k_mapped_mse.svg")
             && !md.contains("stale block"),
         "{md}"
     );

@@ -214,7 +214,7 @@ impl Robustness {
              encodes the filled input and decodes a full BRDF.\n"
         );
         s.push_str(&self.table());
-        let _ = writeln!(s, "\n![Fig. 2 robustness](robustness.png)\n");
+        let _ = writeln!(s, "\n![Fig. 2 robustness](robustness.svg)\n");
         if let Some(m) = fig2_material {
             let _ = writeln!(s, "![Fig. 2 slices of {m}](fig2_slices.png)\n");
         }
@@ -222,7 +222,7 @@ impl Robustness {
         s
     }
 
-    /// Writes `robustness.csv` (every record) and `robustness.{png,svg}` into `dir`.
+    /// Writes `robustness.csv` (every record) and `robustness.svg` into `dir`.
     pub fn write(&self, dir: &Path) -> Result<()> {
         let mut csv = String::from("input,method,k,fold,material,mapped_mse\n");
         for r in &self.records {
@@ -345,7 +345,6 @@ mod tests {
             let k = rec.k.map(|k| k.to_string()).unwrap_or_default();
             assert!(line.contains(&format!(",{k},0,")), "{line}");
         }
-        assert!(dir.path().join("robustness.png").is_file());
         assert!(dir.path().join("robustness.svg").is_file());
     }
 }

@@ -2,6 +2,7 @@
 //! training tables, the mapped §3.2 layouts, training (§3.2) and the saved model artifact.
 
 use std::path::Path;
+use std::time::Duration;
 
 use burn::prelude::*;
 use deepbrdf_data::mapping::MedianReference;
@@ -10,14 +11,16 @@ use deepbrdf_data::{MerlTable, Progress};
 use crate::artifact::{ModelArtifact, MODEL_DIR};
 use crate::codec::DeepBrdf;
 use crate::error::Result;
-use crate::train::{train, TrainConfig};
+use crate::train::{train_within, TrainConfig};
 use crate::training_set::TrainingSet;
 
 /// Trains DeepBRDF on `tables` (named `names`, from the data source `label`), keeping the
 /// checkpoint and log in `out_dir` and writing the model artifact to `out_dir/model`.
 ///
 /// With `resume`, an interrupted run in `out_dir` is continued (a finished one is only
-/// re-evaluated and re-saved); without it, an existing run there is an error.
+/// re-evaluated and re-saved); without it, an existing run there is an error. With a
+/// `time_limit`, training stops at the end of the first epoch past it and the model written
+/// has the epochs done so far (its provenance says how many); `resume` continues the run.
 #[allow(clippy::too_many_arguments)]
 pub fn fit(
     config: &TrainConfig,
@@ -26,13 +29,14 @@ pub fn fit(
     tables: &[&MerlTable],
     out_dir: &Path,
     resume: bool,
+    time_limit: Option<Duration>,
     progress: &dyn Progress,
     device: &Device,
 ) -> Result<DeepBrdf> {
     config.validate()?;
     let reference = MedianReference::from_tables(tables)?;
     let set = TrainingSet::from_tables(label, names, tables, &reference)?;
-    let trained = train(config, &set, out_dir, resume, progress, device)?;
+    let trained = train_within(config, &set, out_dir, resume, time_limit, progress, device)?;
     drop(set);
     let artifact = ModelArtifact::from_trained(trained, reference, label, names, device)?;
     artifact.save(&out_dir.join(MODEL_DIR))?;

@@ -45,5 +45,5 @@ pub use error::{ModelError, Result};
 pub use fit::fit;
 pub use preset::Preset;
 pub use regressor::Regressor;
-pub use train::{train, EpochRecord, SliceDropoutConfig, TrainConfig, Trained};
+pub use train::{train, train_within, EpochRecord, SliceDropoutConfig, TrainConfig, Trained};
 pub use training_set::TrainingSet;

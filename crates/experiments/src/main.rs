@@ -16,6 +16,7 @@ mod refine_arg;
 mod scene_args;
 mod serve;
 mod stats;
+mod time_limit_arg;
 mod warnings;
 
 use clap::Parser;

@@ -67,6 +67,9 @@ pub struct DeepMethod {
     retained: Option<Vec<usize>>,
     /// How its models refine their encodings ([`deepbrdf_model::refine`]).
     refinement: Refinement,
+    /// Each training stops at the end of the first epoch past this; a rerun resumes it
+    /// ([`deepbrdf_model::train_within`]).
+    time_limit: Option<std::time::Duration>,
 }
 
 impl DeepMethod {
@@ -83,7 +86,15 @@ impl DeepMethod {
             models: Mutex::new(Vec::new()),
             retained: None,
             refinement: Refinement::default(),
+            time_limit: None,
         }
+    }
+
+    /// Stops each training at the end of the first epoch past `limit` (the model of the epochs
+    /// done so far is evaluated; a rerun with the same settings resumes the training).
+    pub fn training_within(mut self, limit: Option<std::time::Duration>) -> Self {
+        self.time_limit = limit;
+        self
     }
 
     /// Encodes with `refinement` ([`DeepBrdf::with_refinement`]).
@@ -167,26 +178,33 @@ impl DeepMethod {
                         .map_err(|e| model_error(&dir, e))?,
                     ),
                 };
-                let model =
-                    deepbrdf_model::train(&config, mapped, &dir, true, progress, &self.device)
-                        .and_then(|trained| {
-                            let artifact = ModelArtifact::from_trained(
-                                trained,
-                                train.reference.clone(),
-                                &self.label,
-                                names,
-                                &self.device,
-                            )?;
-                            artifact.save(&dir.join(MODEL_DIR))?;
-                            if config.model.spectral_only() {
-                                // Retraining takes seconds; the checkpoint (the f32 network,
-                                // 1.7 GB) would more than double the 0.7 GB model on disk. The
-                                // saved model is what a rerun loads.
-                                let _ = std::fs::remove_file(dir.join(CHECKPOINT_FILE));
-                            }
-                            DeepBrdf::from_artifact(artifact, &self.device)
-                        })
-                        .map_err(|e| model_error(&dir, e))?;
+                let model = deepbrdf_model::train_within(
+                    &config,
+                    mapped,
+                    &dir,
+                    true,
+                    self.time_limit,
+                    progress,
+                    &self.device,
+                )
+                .and_then(|trained| {
+                    let artifact = ModelArtifact::from_trained(
+                        trained,
+                        train.reference.clone(),
+                        &self.label,
+                        names,
+                        &self.device,
+                    )?;
+                    artifact.save(&dir.join(MODEL_DIR))?;
+                    if config.model.spectral_only() {
+                        // Retraining takes seconds; the checkpoint (the f32 network,
+                        // 1.7 GB) would more than double the 0.7 GB model on disk. The
+                        // saved model is what a rerun loads.
+                        let _ = std::fs::remove_file(dir.join(CHECKPOINT_FILE));
+                    }
+                    DeepBrdf::from_artifact(artifact, &self.device)
+                })
+                .map_err(|e| model_error(&dir, e))?;
                 (model, FitOrigin::Trained)
             }
         };

@@ -360,7 +360,7 @@ mod tests {
         assert_eq!(csv.lines().count(), 1 + results.records.len());
         let md = std::fs::read_to_string(dir.path().join("summary.md")).unwrap();
         assert!(md.contains("| IPCA |") && md.contains("k = 5"), "{md}");
-        for f in ["error_vs_k_mapped_mse.png", "per_material_cos_rmse.svg", "fits.csv"] {
+        for f in ["error_vs_k_mapped_mse.svg", "per_material_cos_rmse.svg", "fits.csv"] {
             assert!(dir.path().join(f).is_file(), "{f} missing");
         }
     }

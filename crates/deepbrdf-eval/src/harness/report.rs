@@ -153,8 +153,8 @@ impl Results {
             self.eval_seconds, self.total_seconds
         );
         for &m in &self.measures {
-            let _ = writeln!(s, "![{} vs k](error_vs_k_{}.png)\n", m.label(), m.name());
-            let _ = writeln!(s, "![{} per material](per_material_{}.png)\n", m.label(), m.name());
+            let _ = writeln!(s, "![{} vs k](error_vs_k_{}.svg)\n", m.label(), m.name());
+            let _ = writeln!(s, "![{} per material](per_material_{}.svg)\n", m.label(), m.name());
         }
         s
     }
@@ -374,10 +374,10 @@ mod tests {
 
         let dir = tempfile::tempdir().unwrap();
         results.write(dir.path()).unwrap();
-        let png = image::open(dir.path().join("per_material_mapped_mse.png")).unwrap();
-        assert_eq!((png.width(), png.height()), (1700, 4 * 640));
+        let svg = std::fs::read_to_string(dir.path().join("per_material_mapped_mse.svg")).unwrap();
+        assert!(svg.contains(r#"width="1700" height="2560""#), "{}", &svg[..200.min(svg.len())]);
         let md = std::fs::read_to_string(dir.path().join("summary.md")).unwrap();
-        assert!(md.contains("| DeepBRDF |") && md.contains("per_material_cos_rmse.png"), "{md}");
+        assert!(md.contains("| DeepBRDF |") && md.contains("per_material_cos_rmse.svg"), "{md}");
         let csv = std::fs::read_to_string(dir.path().join("results.csv")).unwrap();
         assert_eq!(csv.lines().count(), 1 + 3 * 4 * 100 * 2);
         // Rewriting into the same folder replaces the files and leaves no temporary file.

@@ -18,7 +18,9 @@ mod progress;
 pub mod run;
 pub mod schedule;
 
-pub use autoencoder::{evaluate, saved_config, train, SliceDropoutConfig, TrainConfig, Trained};
+pub use autoencoder::{
+    evaluate, saved_config, train, train_within, SliceDropoutConfig, TrainConfig, Trained,
+};
 pub use checkpoint::{checkpoint_path, json_close, CHECKPOINT_FILE, CONFIG_FILE};
 pub use config::{adam, LoopConfig};
 pub use log::{EpochRecord, LOG_FILE};

@@ -4,7 +4,7 @@
 
 use std::fs;
 use std::path::Path;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use burn::module::Module;
 use burn::optim::{GradientsParams, MultiGradientsParams};
@@ -81,6 +81,9 @@ pub struct Session<'a> {
     resume: bool,
     progress: &'a dyn Progress,
     label: String,
+    /// Stop at the end of the first epoch that ends this long after the run started (the
+    /// checkpoint then resumes it).
+    time_limit: Option<Duration>,
     /// Tests: stop as if killed right after batch `(epoch, batch)` (0-based) was applied and
     /// before anything was written for it.
     kill_after: Option<(usize, usize)>,
@@ -93,7 +96,16 @@ impl<'a> Session<'a> {
     /// starts afresh. Without `resume`, an existing checkpoint is an error: nothing is
     /// overwritten.
     pub fn new(dir: &'a Path, resume: bool, progress: &'a dyn Progress, label: &str) -> Self {
-        Self { dir, resume, progress, label: label.to_string(), kill_after: None }
+        Self { dir, resume, progress, label: label.to_string(), time_limit: None, kill_after: None }
+    }
+
+    /// Stops the run at the end of the first epoch that ends `limit` after it started, with a
+    /// checkpoint, so a machine lent for a bounded time trains as far as it can and a later
+    /// `resume` continues exactly there. The network returned then has the epochs done so far
+    /// ([`Outcome::log`]). `None`: no limit.
+    pub fn with_time_limit(mut self, limit: Option<Duration>) -> Self {
+        self.time_limit = limit;
+        self
     }
 
     /// The run's directory.
@@ -118,7 +130,8 @@ impl<'a> Session<'a> {
     }
 }
 
-/// The result of [`run`].
+/// The result of [`run`]: the network after all the configured epochs, or after those done
+/// within the session's time limit (then `log` is shorter than the configuration's epochs).
 #[derive(Debug)]
 pub struct Outcome<M> {
     /// The trained network (still on the autodiff device; `valid()` for inference).
@@ -187,6 +200,7 @@ pub fn run<S: TrainStep>(
         config.batch_size,
     );
     let mut last_checkpoint = Instant::now();
+    let deadline = session.time_limit.map(|limit| Instant::now() + limit);
     while state.epoch < config.epochs {
         let order = epoch_order(config.seed, state.epoch, examples);
         let mut lr = config.learning_rate_at(state.epoch * batches, total_steps);
@@ -230,11 +244,26 @@ pub fn run<S: TrainStep>(
         // Every `checkpoint_seconds` and at the end (epochs of small networks take
         // milliseconds; a checkpoint of the spectral preset holds a ~1 GB basis).
         let last = state.epoch == config.epochs;
-        if last || last_checkpoint.elapsed().as_secs_f64() >= config.checkpoint_seconds {
+        let out_of_time = !last && deadline.is_some_and(|d| Instant::now() >= d);
+        if last
+            || out_of_time
+            || last_checkpoint.elapsed().as_secs_f64() >= config.checkpoint_seconds
+        {
             checkpoint::save(&checkpoint, &step.checkpointed(&model), &optim, &state)?;
             last_checkpoint = Instant::now();
         }
         write_log(&dir.join(LOG_FILE), &state.log)?;
+        if out_of_time {
+            session.progress.status(&format!(
+                "{}: time limit reached after epoch {} of {}; resume continues from the \
+                 checkpoint in {}",
+                session.label,
+                state.epoch,
+                config.epochs,
+                dir.display()
+            ));
+            break;
+        }
     }
     progress.finish();
     Ok(Outcome { model, log: state.log, seconds: state.total_seconds })

@@ -152,6 +152,32 @@ fn an_abandoned_regressor_run_resumes_to_the_same_bits() {
 }
 
 #[test]
+fn a_run_out_of_time_stops_at_an_epoch_end_and_resumes_to_the_same_bits() {
+    let straight_dir = tempfile::tempdir().unwrap();
+    let session = Session::new(straight_dir.path(), false, &Silent, "mlp");
+    let straight = train_regressor(&mut pairs(37, 1.0), &session).unwrap();
+
+    // A limit already passed: the run stops at the end of its first epoch, with a checkpoint.
+    let dir = tempfile::tempdir().unwrap();
+    let limited = Session::new(dir.path(), false, &Silent, "mlp")
+        .with_time_limit(Some(std::time::Duration::ZERO));
+    let first = train_regressor(&mut pairs(37, 1.0), &limited).unwrap();
+    assert_eq!(first.log.len(), 1);
+    assert_eq!(first.log[0].loss, straight.log[0].loss);
+    assert!(dir.path().join(CHECKPOINT_FILE).is_file());
+    // Twice more under the same limit: one epoch each.
+    let again = Session::new(dir.path(), true, &Silent, "mlp")
+        .with_time_limit(Some(std::time::Duration::ZERO));
+    assert_eq!(train_regressor(&mut pairs(37, 1.0), &again).unwrap().log.len(), 2);
+    assert_eq!(train_regressor(&mut pairs(37, 1.0), &again).unwrap().log.len(), 3);
+    // Without a limit it finishes exactly as the uninterrupted run.
+    let resume = Session::new(dir.path(), true, &Silent, "mlp");
+    let resumed = train_regressor(&mut pairs(37, 1.0), &resume).unwrap();
+    assert_eq!(resumed.log.len(), 30);
+    assert_eq!(weights(&resumed.model), weights(&straight.model));
+}
+
+#[test]
 fn a_diverging_regressor_stops_with_a_clear_error() {
     // Targets of 1e30: the squared error overflows f32 on the first batch.
     let dir = tempfile::tempdir().unwrap();

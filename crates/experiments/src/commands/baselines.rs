@@ -51,6 +51,10 @@ pub struct Args {
     pub preset: deepbrdf_model::Preset,
     #[command(flatten)]
     pub refine: crate::refine_arg::RefineArg,
+    /// The deepbrdf method stops each training at the end of the first epoch past this many
+    /// seconds and is evaluated as far as it got (a rerun resumes the training).
+    #[arg(long, value_name = "SECONDS", value_parser = crate::time_limit_arg::parse)]
+    pub time_limit: Option<std::time::Duration>,
     /// Where the deepbrdf method trains its models (`fold<F>/k<K>`) [default: <out>/models].
     #[arg(long, value_name = "DIR")]
     pub models: Option<PathBuf>,
@@ -156,7 +160,8 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         crate::device_arg::device()?,
     )
     .retaining(&[])
-    .refining(args.refine.refinement()?);
+    .refining(args.refine.refinement()?)
+    .training_within(args.time_limit);
     let methods: Vec<&dyn Method> = args
         .methods
         .iter()

@@ -418,7 +418,7 @@ fn write_outputs(
     }
     for set in &sets {
         writeln!(md)?;
-        writeln!(md, "![{set}, per material](per_material_{set}.png)")?;
+        writeln!(md, "![{set}, per material](per_material_{set}.svg)")?;
         per_material_chart(rows, set, &args.out.join(format!("per_material_{set}")))?;
     }
     deepbrdf_data::files::write_atomic(&args.out.join("summary.md"), md.as_bytes())?;
@@ -468,14 +468,14 @@ fn write_outputs(
         sheet.write_png(&args.out.join("fig17.png"))?;
     }
     eprintln!(
-        "wrote {}/summary.md, per_image.csv, per_material_*.png, fig16.png, fig17.png",
+        "wrote {}/summary.md, per_image.csv, per_material_*.svg, fig16.png, fig17.png",
         args.out.display()
     );
     Ok(())
 }
 
 /// The novel-scene RelAE of each method per material of test set `set` (the mean over the
-/// material's images), materials sorted by the methods' geometric mean, as `<stem>.png/.svg`.
+/// material's images), materials sorted by the methods' geometric mean, as `<stem>.svg`.
 fn per_material_chart(rows: &[Row], set: &str, stem: &std::path::Path) -> anyhow::Result<()> {
     let rs: Vec<&Row> = rows.iter().filter(|r| r.set == set).collect();
     let mut materials: Vec<&str> = rs.iter().map(|r| r.material.as_str()).collect();

@@ -508,13 +508,13 @@ impl Report<'_> {
             s.push_str(&measure_table(self.results, Measure::ImageRelae));
             let _ = writeln!(
                 s,
-                "\n![per-material image-space RelAE (Fig. 7)]({link}/per_material_image_relae.png)\n"
+                "\n![per-material image-space RelAE (Fig. 7)]({link}/per_material_image_relae.svg)\n"
             );
         }
         let _ = writeln!(s, "Mean MSE in the eq. (1) mapped space (Fig. 3):\n");
         s.push_str(&measure_table(self.results, Measure::MappedMse));
-        let _ = writeln!(s, "\n![error vs k (Fig. 3)]({link}/error_vs_k_mapped_mse.png)\n");
-        let _ = writeln!(s, "![per-material error (Fig. 7)]({link}/per_material_mapped_mse.png)\n");
+        let _ = writeln!(s, "\n![error vs k (Fig. 3)]({link}/error_vs_k_mapped_mse.svg)\n");
+        let _ = writeln!(s, "![per-material error (Fig. 7)]({link}/per_material_mapped_mse.svg)\n");
         if self.results.measures.contains(&Measure::CosRmse) {
             let _ = writeln!(s, "Mean cosine-weighted RMSE (1/sr):\n");
             s.push_str(&measure_table(self.results, Measure::CosRmse));
@@ -523,7 +523,7 @@ impl Report<'_> {
         let _ =
             writeln!(s, "Robustness to missing phi_d slices (Fig. 2), mean mapped-space MSE:\n");
         s.push_str(&self.robustness.table());
-        let _ = writeln!(s, "\n![robustness (Fig. 2)]({link}/robustness.png)\n");
+        let _ = writeln!(s, "\n![robustness (Fig. 2)]({link}/robustness.svg)\n");
         if self.fig2.is_some() {
             let _ = writeln!(s, "![slices (Fig. 2)]({link}/fig2_slices.png)\n");
         }
@@ -574,12 +574,30 @@ fn measure_table(results: &Results, measure: Measure) -> String {
     s
 }
 
-/// `out` as a link from the folder of `readme`: relative when inside it, else absolute.
+/// `out` as a relative link from the folder of `readme` (`../results/...` from `docs/`);
+/// absolute only where no relative path exists.
 fn relative_link(readme: &Path, out: &Path) -> anyhow::Result<String> {
     let out = out.canonicalize().with_context(|| format!("resolving {}", out.display()))?;
     let readme =
         readme.canonicalize().with_context(|| format!("resolving {}", readme.display()))?;
     let base = readme.parent().unwrap_or(Path::new("/"));
-    let path = out.strip_prefix(base).map(Path::to_path_buf).unwrap_or(out);
+    let path = pathdiff::diff_paths(&out, base).unwrap_or(out);
     Ok(path.to_string_lossy().replace('\\', "/"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::relative_link;
+
+    #[test]
+    fn results_links_are_relative_to_the_markdown_files_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        let (docs, results) = (dir.path().join("docs"), dir.path().join("results").join("run"));
+        std::fs::create_dir_all(&docs).unwrap();
+        std::fs::create_dir_all(&results).unwrap();
+        std::fs::write(docs.join("results.md"), "").unwrap();
+        std::fs::write(dir.path().join("README.md"), "").unwrap();
+        assert_eq!(relative_link(&docs.join("results.md"), &results).unwrap(), "../results/run");
+        assert_eq!(relative_link(&dir.path().join("README.md"), &results).unwrap(), "results/run");
+    }
 }

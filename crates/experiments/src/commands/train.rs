@@ -1,6 +1,6 @@
 //! `experiments train`: train DeepBRDF (§3.2) on a dataset and save the model artifact.
 //!
-//! `experiments train --k 10 [--preset cpu|paper] [--epochs N] [--batch N] [--lr X] [--seed S]
+//! `experiments train --k 10 [--preset slice|paper|cpu] [--epochs N] [--batch N] [--lr X] [--seed S]
 //! [--slice-dropout P] --out DIR` starts a run; `--resume DIR` (or `--out DIR --resume`)
 //! continues an interrupted one exactly where its last checkpoint left it, with the settings
 //! saved in its checkpoint. The model is written to `DIR/model`; `DIR/train_log.csv` has one row
@@ -20,9 +20,10 @@ pub struct Args {
     /// --config].
     #[arg(long)]
     pub k: Option<usize>,
-    /// cpu (sized for a 2-core CPU, see README) or paper (Table 1, lr 2e-5, batch 32,
-    /// 1000 epochs: for GPUs).
-    #[arg(long, default_value = "cpu", value_parser = parse_preset)]
+    /// slice (the shipped model's network: one basis for all phi_d slices and a shared MLP
+    /// decoder, sized for a 2-core CPU), paper (Table 1, lr 2e-5, batch 32, 1000 epochs: for
+    /// GPUs) or cpu (the earlier spectral network, superseded by slice).
+    #[arg(long, default_value = "slice", value_parser = parse_preset)]
     pub preset: Preset,
     /// A training configuration (JSON, as saved in DIR/train_config.json) instead of a preset.
     #[arg(long, value_name = "FILE", conflicts_with = "preset")]
@@ -50,6 +51,11 @@ pub struct Args {
     /// Output directory (checkpoint, log, configuration, and the model in DIR/model).
     #[arg(long, value_name = "DIR", required_unless_present = "resume")]
     pub out: Option<PathBuf>,
+    /// Stop at the end of the first epoch past this many seconds of training, writing the model
+    /// of the epochs done so far (its provenance says how many) and keeping the checkpoint, so
+    /// `--resume` continues the run (for a machine lent for a bounded time).
+    #[arg(long, value_name = "SECONDS", value_parser = crate::time_limit_arg::parse)]
+    pub time_limit: Option<std::time::Duration>,
     /// Continue the interrupted run in DIR (or in --out), with its saved settings.
     #[arg(long, value_name = "DIR", num_args = 0..=1)]
     pub resume: Option<Option<PathBuf>>,
@@ -157,7 +163,17 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         config.batch_size
     );
     let tables: Vec<_> = data.tables.iter().collect();
-    let model = fit(&config, &data.label, &data.names, &tables, &out, resume, progress, &device)?;
+    let model = fit(
+        &config,
+        &data.label,
+        &data.names,
+        &tables,
+        &out,
+        resume,
+        args.time_limit,
+        progress,
+        &device,
+    )?;
     let p = model.provenance();
     println!(
         "trained {} epochs in {:.0} s: final loss {:.4e}, mapped-space MSE {:.4e} over {} BRDFs",
@@ -167,6 +183,14 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         p.final_mse,
         p.materials.len()
     );
+    if p.epochs < config.epochs {
+        println!(
+            "stopped at the time limit after {} of {} epochs; continue with --resume {}",
+            p.epochs,
+            config.epochs,
+            out.display()
+        );
+    }
     println!("model {} written to {}", model.id(), out.join("model").display());
     drop(lock);
     Ok(())

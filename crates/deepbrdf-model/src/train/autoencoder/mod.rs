@@ -8,6 +8,7 @@ mod slice_step;
 mod step;
 
 use std::path::Path;
+use std::time::Duration;
 
 use burn::prelude::*;
 use deepbrdf_data::Progress;
@@ -69,7 +70,24 @@ pub fn train(
     progress: &dyn Progress,
     device: &Device,
 ) -> crate::error::Result<Trained> {
-    train_in(config, data, &Session::new(out_dir, resume, progress, &label(config)), device)
+    train_within(config, data, out_dir, resume, None, progress, device)
+}
+
+/// [`train`], stopping at the end of the first epoch that ends `time_limit` after the start
+/// (with a checkpoint that `resume` continues; [`Session::with_time_limit`]): the network
+/// returned then has the epochs done so far ([`Trained::log`]).
+pub fn train_within(
+    config: &TrainConfig,
+    data: &TrainingSet,
+    out_dir: &Path,
+    resume: bool,
+    time_limit: Option<Duration>,
+    progress: &dyn Progress,
+    device: &Device,
+) -> crate::error::Result<Trained> {
+    let session =
+        Session::new(out_dir, resume, progress, &label(config)).with_time_limit(time_limit);
+    train_in(config, data, &session, device)
 }
 
 fn label(config: &TrainConfig) -> String {
