@@ -18,7 +18,6 @@ use deepbrdf_model::refine::Refinement;
 use deepbrdf_model::train::{json_close, CHECKPOINT_FILE};
 use deepbrdf_model::{DeepBrdf, ModelArtifact, TrainConfig, TrainingSet as MappedSet};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
 /// The training configuration of one k: a function of k (a preset, possibly with overrides).
@@ -50,15 +49,14 @@ pub struct FitRecord {
 
 /// DeepBRDF as a harness [`Method`].
 ///
-/// Folds are numbered in the order the harness fits them (its folds are deterministic in the
-/// seed, so a rerun with the same settings finds the same directories).
+/// Each fold's models live in `fold<F>/k<K>` under the models directory, F the harness' fold
+/// index ([`FoldTraining::fold`]; its folds are deterministic in the seed, so a rerun with the
+/// same settings finds the same directories).
 pub struct DeepMethod {
     config_for: Box<ConfigFor>,
     models_dir: PathBuf,
     label: String,
     device: Device,
-    /// The fold the next [`Method::fit_fold`] call fits.
-    next_fold: AtomicUsize,
     fits: Mutex<Vec<FitRecord>>,
     models: Mutex<Vec<(usize, usize, Arc<DeepBrdf>)>>,
     /// The k whose models stay in memory after their fold (all when `None`; the others are
@@ -81,7 +79,6 @@ impl DeepMethod {
             models_dir: models_dir.to_path_buf(),
             label: label.to_string(),
             device,
-            next_fold: AtomicUsize::new(0),
             fits: Mutex::new(Vec::new()),
             models: Mutex::new(Vec::new()),
             retained: None,
@@ -299,7 +296,7 @@ impl Method for DeepMethod {
         NAME.to_string()
     }
 
-    /// Fits into the directory of the fold currently being fitted.
+    /// Fits into the directory of fold 0 (a fit outside the harness' folds).
     fn fit(
         &self,
         train: &[&MerlTable],
@@ -307,12 +304,12 @@ impl Method for DeepMethod {
         k: usize,
         progress: &dyn Progress,
     ) -> Result<Box<dyn Codec>> {
-        let fold = self.next_fold.load(Ordering::SeqCst);
         let reference = MedianReference::from_tables(train)?;
         let tables = train.to_vec();
         let indices: Vec<usize> = (0..tables.len()).collect();
-        let set = FoldTraining { set: &tables, indices: &indices, names, reference: &reference };
-        self.fit_in(fold, &set, k, &Arc::default(), &mut None, &mut Vec::new(), progress)
+        let set =
+            FoldTraining { fold: 0, set: &tables, indices: &indices, names, reference: &reference };
+        self.fit_in(set.fold, &set, k, &Arc::default(), &mut None, &mut Vec::new(), progress)
     }
 
     fn fit_fold(
@@ -321,7 +318,7 @@ impl Method for DeepMethod {
         ks: &[usize],
         progress: &dyn Progress,
     ) -> Result<Vec<Box<dyn Codec>>> {
-        let fold = self.next_fold.load(Ordering::SeqCst);
+        let fold = train.fold;
         let cache = Arc::new(InputCache::default());
         let mut set = None;
         let mut fold_models = Vec::new();
@@ -329,7 +326,6 @@ impl Method for DeepMethod {
             .iter()
             .map(|&k| self.fit_in(fold, train, k, &cache, &mut set, &mut fold_models, progress))
             .collect::<Result<Vec<_>>>()?;
-        self.next_fold.store(fold + 1, Ordering::SeqCst);
         Ok(codecs)
     }
 }

@@ -13,6 +13,9 @@ use std::borrow::Cow;
 /// needs one table at a time never holds them all.
 #[derive(Clone, Copy)]
 pub struct FoldTraining<'a> {
+    /// The fold's index in the harness' split (0 in in-sample and generalize modes): methods
+    /// that keep files per fold (DeepBRDF's model directories) name them by it.
+    pub fold: usize,
     pub set: &'a dyn TableSet,
     pub indices: &'a [usize],
     /// `names[j]` names training table `j`.

@@ -188,6 +188,7 @@ pub fn run_with_extra(
             Yardstick::from_training(&refs)?
         };
         let set = FoldTraining {
+            fold: fold.index,
             set: train.tables,
             indices: &fold.train,
             names: &names,

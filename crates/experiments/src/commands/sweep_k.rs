@@ -74,7 +74,9 @@ pub struct Args {
     /// rgl-measured, the real measurements].
     #[arg(long, value_delimiter = ',', value_name = "NAME,...")]
     pub eval_collections: Option<Vec<Collection>>,
-    /// Output folder [default: results/sweep-k, or results/sweep-k-kfoldN in k-fold mode].
+    /// Output folder [default: runs/sweep-k, runs/sweep-k-kfoldN in k-fold mode,
+    /// runs/sweep-k-generalize; `runs/` is not tracked, so a run never replaces the committed
+    /// results: `--out results/sweep-k-kfold5` refreshes them].
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Error measures (comma-separated): mapped_mse (eq. 1 space, the paper's training loss),
@@ -143,9 +145,9 @@ impl Args {
 
     fn out_dir(&self) -> PathBuf {
         self.out.clone().unwrap_or_else(|| match self.mode {
-            Mode::KFold { folds } => PathBuf::from(format!("results/sweep-k-kfold{folds}")),
-            Mode::Generalize => PathBuf::from("results/sweep-k-generalize"),
-            _ => PathBuf::from("results/sweep-k"),
+            Mode::KFold { folds } => PathBuf::from(format!("runs/sweep-k-kfold{folds}")),
+            Mode::Generalize => PathBuf::from("runs/sweep-k-generalize"),
+            _ => PathBuf::from("runs/sweep-k"),
         })
     }
 
