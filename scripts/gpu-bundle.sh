@@ -15,8 +15,8 @@
 #   (for the Burn-beside-PyTorch timing).
 #
 # It prints the bundle's size and the size of what travels with it (tracked files and
-# untracked files git does not ignore), and fails when the two together pass 64 MiB, the
-# device machine's limit. Set CARGO_TARGET_DIR to reuse a build (default target-gpu).
+# untracked files git does not ignore), on disk (whole blocks, as the device machine's limit
+# counts them), and fails when the two together pass 64 MiB, that limit. Set CARGO_TARGET_DIR to reuse a build (default target-gpu).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bundle="${1:-.gpu}"
@@ -46,9 +46,9 @@ if [[ -f ../shared/bench/torch_table1.py ]]; then
     cp ../shared/bench/torch_table1.py "$bundle/"
 fi
 
-bundle_bytes=$(du -cb "$bundle" | tail -1 | cut -f1)
-tree_bytes=$(git ls-files -z --cached --others --exclude-standard | xargs -0 du -cb 2>/dev/null \
-    | awk '$2 == "total" { s += $1 } END { print s + 0 }')
+bundle_bytes=$(du -c -B1 "$bundle" | tail -1 | cut -f1)
+tree_bytes=$(git ls-files -z --cached --others --exclude-standard | xargs -0 du -c -B1 2>/dev/null \
+    | awk '$2 == "total" { s += $1 } END { print s + 0 }') || true # du names deleted files
 mib() { awk -v b="$1" 'BEGIN { printf "%.1f MiB", b / 1048576 }'; }
 echo "bundle $bundle: $(mib "$bundle_bytes") (binary $(mib "$(stat -c %s "$bundle/experiments.xz")") compressed)"
 echo "tree that travels: $(mib "$tree_bytes"); together $(mib $((bundle_bytes + tree_bytes))) of 64 MiB"

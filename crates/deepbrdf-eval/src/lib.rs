@@ -12,5 +12,6 @@ pub mod ipca;
 pub mod metrics;
 pub mod pca;
 pub mod robustness;
+pub mod stats;
 
 pub use error::{EvalError, Result};

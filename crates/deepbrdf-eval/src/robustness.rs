@@ -11,7 +11,8 @@
 use crate::deep::{DeepMethod, MappedInput, NAME};
 use crate::error::{EvalError, Result};
 use crate::figures::{write_chart, LineChart, Series};
-use crate::harness::{csv_field, mean, Fold, Measure, Results, Yardstick};
+use crate::harness::{csv_field, Fold, Measure, Results, Yardstick};
+use crate::stats::mean;
 use deepbrdf_data::augment::{kept_slices, SliceSelection};
 use deepbrdf_data::files::write_atomic;
 use deepbrdf_data::table_set::TableSet;

@@ -15,7 +15,6 @@ mod recovery_inputs;
 mod refine_arg;
 mod scene_args;
 mod serve;
-mod stats;
 mod time_limit_arg;
 mod warnings;
 

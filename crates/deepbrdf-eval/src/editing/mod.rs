@@ -2,15 +2,21 @@
 //! diffuse albedo, the specular albedo or the roughness of a material's 7 [`Attributes`]), and
 //! the measures of how well edits, interpolations and sweeps behave ([`measures`]: achieved vs
 //! requested change and leakage into the other attributes, uniformity of consecutive image
-//! differences, monotonicity of a sweep, physical plausibility of a decoded table). The
-//! regressor of eq. (7) that turns edited attributes into latent values is
-//! `deepbrdf_model::regressor`.
+//! differences, monotonicity of a sweep, physical plausibility of a decoded table; [`lobe`]: the
+//! specular lobe read off the table as a person sees it, its floor, peak, width and colour, a
+//! dark hole at its centre, and the bars an edit is held to). The regressor of eq. (7) that turns
+//! edited attributes into latent values is `deepbrdf_model::regressor`.
 //!
 //! [`Attributes`]: crate::attributes::Attributes
 
+pub mod lobe;
 pub mod measures;
 pub mod request;
 
+pub use lobe::{
+    compare, dark_hole, judge_edit, verdict, BarCount, EditLobe, Lobe, LobeBar, LobeComparison,
+    LobeTally, LobeVerdict,
+};
 pub use measures::{
     coefficient_of_variation, directional_albedo, edit_outcome, is_monotone, plausibility,
     EditOutcome, Plausibility,

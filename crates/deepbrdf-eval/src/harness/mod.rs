@@ -13,7 +13,7 @@ pub use codec::{Codec, FoldTraining, Method};
 pub use deepbrdf_data::mapping::MedianReference;
 pub use measures::{Measure, Original, Yardstick};
 pub use modes::{Fold, Mode};
-pub(crate) use report::{csv_field, mean};
+pub(crate) use report::csv_field;
 pub use report::{FitTiming, Record, Results};
 
 use crate::error::{EvalError, Result};

@@ -6,6 +6,7 @@ use super::measures::Measure;
 use super::modes::Mode;
 use crate::error::{EvalError, Result};
 use crate::figures::{write_chart, write_panels, LineChart, Series};
+use crate::stats::mean;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -291,12 +292,6 @@ impl Results {
             })
             .collect()
     }
-}
-
-/// The mean of `values`, summed in order (`None` when there is none).
-pub(crate) fn mean(values: impl IntoIterator<Item = f64>) -> Option<f64> {
-    let v: Vec<f64> = values.into_iter().collect();
-    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
 }
 
 /// A CSV field, quoted when it holds a comma, a quote or a line break (RFC 4180).

@@ -12,24 +12,27 @@
 //!   and IPCA (at the model's k), paper and residual edits: the attributes re-estimated on each
 //!   decoded table against the requested ones (target error, change ratio, drift of the
 //!   untouched attributes), the identity edit's image RelAE against the original, the
-//!   plausibility of every decoded table; and the monotonicity of the re-estimated roughness
-//!   along each Fig. 13/14 sweep.
+//!   plausibility of every decoded table; the specular lobe read off each decoded table against
+//!   the original's (`deepbrdf_eval::editing::lobe`: diffuse floor, peak and half width ratios, a
+//!   dark hole at the highlight, and the bar each edit is held to); and the monotonicity of the
+//!   re-estimated roughness along each Fig. 13/14 sweep.
 //!
 //! Writes `results.md` (the tables), `suite.csv` (every material and edit) and the figures.
 use super::interpolate::{self, Path3};
 use super::train_regressor::{self, IPCA_BASIS_FILE};
 use crate::data_args::DataArgs;
 use crate::editing::{self, ipca_owner_id, EditMode, EditorArg, ModelCodec, Space};
-use crate::stats::{mean, median};
 use anyhow::Context;
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::attributes::{Attributes, FitConfig};
 use deepbrdf_eval::baseline::{BaselineBasis, MappingKind};
 use deepbrdf_eval::editing::{
-    edit_outcome, is_monotone, plausibility, ColourEdit, Edit, EditOutcome, ScalarEdit,
+    edit_outcome, is_monotone, judge_edit, plausibility, ColourEdit, Edit, EditLobe, EditOutcome,
+    Lobe, LobeBar, LobeTally, ScalarEdit,
 };
 use deepbrdf_eval::harness::Codec;
 use deepbrdf_eval::metrics::{ImageRelae, ImageRelaeConfig};
+use deepbrdf_eval::stats::{finite_mean, finite_median};
 use deepbrdf_model::regressor::{Regressor, RegressorData, Target, TargetKind};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -85,6 +88,54 @@ struct SuiteRow {
     identity_relae: f64,
     plausible: bool,
     max_albedo: f64,
+    /// The lobe measures; `None` where the original's or the decoded table's lobe is undefined
+    /// (no valid cell where it is read).
+    lobe: Option<EditLobe>,
+}
+
+/// The suite's CSV columns of the lobe measures: floor, peak and HWHM ratios, dark hole, the
+/// edit's bar, whether it meets it, whether it passes (meets its bar, if any, without a dark
+/// hole); empty where the lobe was not measured.
+fn lobe_columns(lobe: Option<&EditLobe>) -> String {
+    let yes = |b: bool| if b { "yes" } else { "no" };
+    let Some(l) = lobe else { return ",,,,,,".into() };
+    let (c, v) = (l.comparison, l.verdict);
+    format!(
+        "{:.6},{:.6},{:.6},{},{},{},{}",
+        c.floor_ratio,
+        c.peak_ratio,
+        c.hwhm_ratio,
+        yes(c.dark_hole),
+        v.bar.map_or("none", LobeBar::key),
+        v.meets_bar.map_or("-", yes),
+        yes(v.passes())
+    )
+}
+
+/// The summary's lobe table: per representation and mode, each bar's count (met / held, and
+/// passed: met without a dark hole), the dark holes and the edits not measured.
+fn lobe_summary(rows: &[SuiteRow]) -> String {
+    let mut md = String::from("| representation | mode |");
+    for bar in LobeBar::ALL {
+        let _ = write!(md, " {}: met / held (passed) |", bar.name());
+    }
+    md += " dark holes | not measured |\n| --- | --- | ---: | ---: | ---: | ---: | ---: |\n";
+    for method in ["DeepBRDF", "IPCA"] {
+        for mode in [EditMode::Paper, EditMode::Residual] {
+            let sel: Vec<&SuiteRow> =
+                rows.iter().filter(|r| r.method == method && r.mode == mode).collect();
+            if sel.is_empty() {
+                continue;
+            }
+            let t = LobeTally::of(sel.iter().filter_map(|r| r.lobe.as_ref().map(|l| &l.verdict)));
+            let _ = write!(md, "| {method} | {} |", mode.name());
+            for c in t.bars {
+                let _ = write!(md, " {}/{} ({}) |", c.met, c.held, c.passed);
+            }
+            let _ = writeln!(md, " {}/{} | {} |", t.dark_holes, t.edits, sel.len() - t.edits);
+        }
+    }
+    md
 }
 
 /// A representation with its regressor, and the latent of each material under it.
@@ -310,10 +361,18 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let chosen: Vec<usize> = (0..set.len()).step_by(args.every as usize).collect();
     let quick = editing::quick_fit();
     let mut rows: Vec<SuiteRow> = Vec::new();
+    let mut lobe_skipped: Vec<String> = Vec::new();
     progress.start(chosen.len() as u64, "edit suite");
     for &m in &chosen {
         let (name, table, original) = (&set.names[m], &set.tables[m], &attrs[m]);
         let reference = ImageRelae::new(table, &ImageRelaeConfig::default())?;
+        let original_lobe = match Lobe::of(table) {
+            Ok(l) => Some(l),
+            Err(e) => {
+                lobe_skipped.push(format!("{name}: {e}"));
+                None
+            }
+        };
         for rep in reps {
             let latent = rep.space.codec.encode(table)?;
             for mode in [EditMode::Paper, EditMode::Residual] {
@@ -329,6 +388,17 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                         _ => f64::NAN,
                     };
                     let p = plausibility(&edited.table);
+                    let lobe =
+                        match original_lobe.as_ref().map(|o| judge_edit(o, &edited.table, &edit)) {
+                            Some(Ok(l)) => Some(l),
+                            Some(Err(e)) => {
+                                let what =
+                                    format!("{name}, {} {} {edit_name}", rep.name, mode.name());
+                                lobe_skipped.push(format!("{what}: {e}"));
+                                None
+                            }
+                            None => None,
+                        };
                     rows.push(SuiteRow {
                         material: name.clone(),
                         method: rep.name,
@@ -338,6 +408,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                         identity_relae,
                         plausible: p.is_plausible(),
                         max_albedo: p.max_albedo,
+                        lobe,
                     });
                 }
             }
@@ -345,12 +416,12 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         progress.advance(1);
     }
     progress.finish();
-    let mut csv = String::from("material,method,mode,edit,target_error,change_ratio,diffuse_drift,specular_drift,roughness_drift,identity_relae,plausible,max_albedo\n");
+    let mut csv = String::from("material,method,mode,edit,target_error,change_ratio,diffuse_drift,specular_drift,roughness_drift,identity_relae,plausible,max_albedo,floor_ratio,peak_ratio,hwhm_ratio,dark_hole,lobe_bar,meets_bar,lobe_pass\n");
     for r in &rows {
         let o = r.outcome;
         let _ = writeln!(
             csv,
-            "{},{},{},{},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{},{:.6}",
+            "{},{},{},{},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{},{:.6},{}",
             r.material,
             r.method,
             r.mode.name(),
@@ -362,7 +433,8 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             o.roughness_drift,
             r.identity_relae,
             r.plausible,
-            r.max_albedo
+            r.max_albedo,
+            lobe_columns(r.lobe.as_ref())
         );
     }
     deepbrdf_data::files::write_atomic(&args.out.join("suite.csv"), csv.as_bytes())?;
@@ -383,7 +455,8 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                 if sel.is_empty() {
                     continue;
                 }
-                let f = |g: fn(&EditOutcome) -> f64| median(sel.iter().map(|r| g(&r.outcome)));
+                let f =
+                    |g: fn(&EditOutcome) -> f64| finite_median(sel.iter().map(|r| g(&r.outcome)));
                 let good = sel
                     .iter()
                     .filter(|r| {
@@ -405,11 +478,19 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                     show(f(|o| o.specular_drift)),
                     show(f(|o| o.roughness_drift)),
                     sel.len(),
-                    show(mean(sel.iter().map(|r| r.identity_relae))),
+                    show(finite_mean(sel.iter().map(|r| r.identity_relae))),
                     sel.len()
                 );
             }
         }
+    }
+    let _ = write!(
+        md,
+        "\n### The specular lobe as a person sees it\n\nRead off each decoded table against the measurement: the luminance over theta_h (theta_d < 15 deg, all phi_d), the diffuse floor (its median for theta_h >= 45 deg), the lobe above it, its peak and half width at half maximum; a dark hole is the lobe at theta_h ~ 0 below 60% of its maximum within 15 deg where the measurement's was not. Per edit in `suite.csv` (`floor_ratio`, `peak_ratio`, `hwhm_ratio`, `dark_hole`, `lobe_bar`, `meets_bar`, `lobe_pass`). Dark holes are counted over every edit, identity included.\n\n{}",
+        lobe_summary(&rows)
+    );
+    for skipped in &lobe_skipped {
+        let _ = writeln!(md, "\nLobe not measured: {skipped}.");
     }
     md += &sweeps_md;
     let _ = write!(md, "\nWhole command {:.0} s.\n", started.elapsed().as_secs_f64());

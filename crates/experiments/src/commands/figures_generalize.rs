@@ -7,7 +7,6 @@
 use crate::data_args::{load_added, CacheArg};
 use crate::editing::ModelCodec;
 use crate::model_arg::ModelArg;
-use crate::stats::mean;
 use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::dataset::{DataSource, Dataset};
@@ -16,6 +15,7 @@ use deepbrdf_data::Progress;
 use deepbrdf_eval::baseline::{BaselineBasis, MappingKind};
 use deepbrdf_eval::harness::Codec;
 use deepbrdf_eval::metrics::{relae, ImageRelae, ImageRelaeConfig};
+use deepbrdf_eval::stats::finite_mean;
 use deepbrdf_model::DeepBrdf;
 use deepbrdf_render::sheet::{contact_sheet, SheetConfig, Tile};
 use deepbrdf_render::Tonemap;
@@ -168,7 +168,8 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         writeln!(csv, "{},{:.6},{:.6}", r.material, r.deepbrdf, r.ipca)?;
         writeln!(md, "| {} | {:.4} | {:.4} |", r.material, r.deepbrdf, r.ipca)?;
     }
-    let (d, i) = (mean(rows.iter().map(|r| r.deepbrdf)), mean(rows.iter().map(|r| r.ipca)));
+    let (d, i) =
+        (finite_mean(rows.iter().map(|r| r.deepbrdf)), finite_mean(rows.iter().map(|r| r.ipca)));
     let wins = rows.iter().filter(|r| r.deepbrdf < r.ipca).count();
     writeln!(md, "| **mean** | **{d:.4}** | **{i:.4}** |")?;
     writeln!(md, "\nDeepBRDF is below IPCA on {wins} of {} materials.", rows.len())?;

@@ -15,13 +15,13 @@
 use crate::data_args::CacheArg;
 use crate::model_arg::ModelArg;
 use crate::recovery_inputs::{attributes_of, load_tables, set_images};
-use crate::stats::{mean, median};
 use anyhow::{bail, Context};
 use deepbrdf_data::merl::{CELLS, INVALID_VALUE, VALUES};
 use deepbrdf_data::{MerlTable, Progress, Silent};
 use deepbrdf_eval::figures::{write_chart, LineChart, Series};
 use deepbrdf_eval::harness::{Measure, Yardstick};
 use deepbrdf_eval::metrics::{ImageRelae, ImageRelaeConfig};
+use deepbrdf_eval::stats::{finite_mean, finite_median};
 use deepbrdf_model::recovery::{RecoveryArtifact, RecoveryTarget};
 use deepbrdf_model::DeepBrdf;
 use deepbrdf_render::sheet::{contact_sheet, SheetConfig, Tile};
@@ -410,9 +410,9 @@ fn write_outputs(
                 "| {set} | {} | {} | {method} | {:.4} | {:.4} | {:.4} | {wins} |",
                 rs.len(),
                 materials.len(),
-                mean(rs.iter().map(|r| r.relae[m])),
-                median(rs.iter().map(|r| r.relae[m])),
-                mean(rs.iter().map(|r| r.mse[m])),
+                finite_mean(rs.iter().map(|r| r.relae[m])),
+                finite_median(rs.iter().map(|r| r.relae[m])),
+                finite_mean(rs.iter().map(|r| r.mse[m])),
             )?;
         }
     }
@@ -482,7 +482,7 @@ fn per_material_chart(rows: &[Row], set: &str, stem: &std::path::Path) -> anyhow
     materials.sort();
     materials.dedup();
     let value = |material: &str, m: usize| {
-        mean(rs.iter().filter(|r| r.material == material).map(|r| r.relae[m]))
+        finite_mean(rs.iter().filter(|r| r.material == material).map(|r| r.relae[m]))
     };
     let key =
         |material: &str| (0..METHODS.len()).map(|m| value(material, m).max(1e-9).ln()).sum::<f64>();

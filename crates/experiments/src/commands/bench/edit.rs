@@ -6,7 +6,6 @@
 use crate::commands::edit::EditArgs;
 use crate::data_args::CacheArg;
 use crate::editing::{self, EditMode, EditorArg, ModelCodec, Space, DEFAULT_MODE};
-use crate::stats::median;
 use anyhow::Context;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::{Progress, Silent};
@@ -14,6 +13,7 @@ use deepbrdf_eval::attributes::FitConfig;
 use deepbrdf_eval::editing::{Edit, ScalarEdit};
 use deepbrdf_eval::harness::Codec;
 use deepbrdf_eval::metrics::ImageRelaeConfig;
+use deepbrdf_eval::stats::finite_median;
 use deepbrdf_render::{render, MerlBrdf};
 use std::time::Instant;
 
@@ -86,10 +86,10 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     );
     println!(
         "one edit: {:.3} s (target <= 0.5 s): regressor {:.5} s, decode {:.3} s, 128 px preview {:.3} s",
-        median(all),
-        median(reg),
-        median(dec),
-        median(ren)
+        finite_median(all),
+        finite_median(reg),
+        finite_median(dec),
+        finite_median(ren)
     );
     println!("once per material: attribute fit {fit:.3} s, encode {encode:.3} s; loading model and regressor {load:.2} s");
     Ok(())

@@ -2,9 +2,9 @@
 //! most 0.5 s on 2 cores): reading and preparing the photo, the recovery CNN, and DeepBRDF's
 //! decode of its latent (eq. 3), each the median of `--repeats` runs after a warm-up.
 use crate::model_arg::ModelArg;
-use crate::stats::median;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::{Progress, Silent};
+use deepbrdf_eval::stats::finite_median;
 use deepbrdf_model::DeepBrdf;
 use deepbrdf_render::{camera_png, render, MerlBrdf, Photo, RenderSettings, Sampler, SceneConfig};
 use std::path::PathBuf;
@@ -67,7 +67,7 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
             dec.push((t3 - t2).as_secs_f64());
         }
     }
-    let (p, n, d) = (median(prep), median(net), median(dec));
+    let (p, n, d) = (finite_median(prep), finite_median(net), finite_median(dec));
     println!(
         "recover {} ({}x{} network input): read + prepare {p:.3} s, network {n:.4} s, decode \
          {d:.3} s; network + decode {:.3} s (target <= 0.5 s), total {:.3} s (medians of {})",

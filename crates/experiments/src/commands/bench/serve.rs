@@ -9,9 +9,9 @@
 use crate::commands::serve::{runtime, start};
 use crate::data_args::CacheArg;
 use crate::editing::EditorArg;
-use crate::stats::median;
 use anyhow::{bail, Context};
 use deepbrdf_data::Progress;
+use deepbrdf_eval::stats::finite_median;
 use serde_json::{json, Value};
 use std::net::{Ipv4Addr, SocketAddr};
 use std::time::{Duration, Instant};
@@ -172,17 +172,17 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         "fast preview (128 px, {} spp), request to image over HTTP: median {:.3} s, max {:.3} s \
          (target <= 0.300 s); in the editor: {:.3} s (decode {:.3} s, render {:.3} s), {} previews",
         crate::serve::editor::FAST.spp,
-        median(trip.clone()),
+        finite_median(trip.clone()),
         max(&trip),
-        median(server),
-        median(decode),
-        median(render),
+        finite_median(server),
+        finite_median(decode),
+        finite_median(render),
         trip.len()
     );
     println!(
         "refined preview (256 px, {} spp, own table sampler, re-estimated attributes): median {:.3} s",
         crate::serve::editor::REFINED.spp,
-        median(refined)
+        finite_median(refined)
     );
     println!(
         "burst of 20 moves in {last_sent:.2} s: {answered} answered, {superseded} superseded \

@@ -1,0 +1,576 @@
+//! Measures of a table's specular lobe that see what a person sees in a rendering: where the
+//! highlight is, how wide, how bright, of what colour, and whether its centre went dark. They
+//! read the table itself, not attributes re-estimated by the Lambertian + GGX fit, which reads a
+//! dark hole at the highlight as a wider lobe.
+//!
+//! The definitions are those of the editing issue that asks for edits that do what they ask:
+//!
+//! - the **specular profile**: the luminance (Rec. 709) of the mean RGB over the valid cells with
+//!   theta_d < 15 deg (all phi_d), one value per theta_h sample that has such a cell;
+//! - the **diffuse floor**: the median of the profile over theta_h >= 45 deg;
+//! - the **lobe**: the profile minus the floor; its **peak** (the maximum) and where it is; its
+//!   **half width at half maximum** (HWHM): from the peak outward (growing theta_h) to the first
+//!   crossing below half the peak, interpolated linearly between theta_h samples;
+//! - the peak's **colour**: the RGB chromaticity of the lobe at the peak, each channel's profile
+//!   minus that channel's floor;
+//! - a **dark hole**: the lobe at theta_h ~ 0 (the first sample) below 60% of the lobe's maximum
+//!   within theta_h <= 15 deg, where the original's was not;
+//! - the **bars** of an edit: roughness x2 widens the HWHM >= 1.4x, roughness x0.5 narrows it to
+//!   <= 0.75x, diffuse x0.5 leaves the floor at 0.35-0.65x with the peak within 25% and its
+//!   colour within 20%; and no edit leaves a dark hole.
+
+use super::request::{ColourEdit, Edit, ScalarEdit};
+use crate::error::{EvalError, Result};
+use crate::stats::finite_median;
+use deepbrdf_data::merl::grid::{cell_index, theta_d_of, theta_h_of};
+use deepbrdf_data::merl::{CELLS, N_PHI_D, N_THETA_D, N_THETA_H};
+use deepbrdf_data::MerlTable;
+use deepbrdf_render::sky::luminance;
+
+/// The profile averages the cells with theta_d below this (degrees): near the mirror
+/// configuration, where a highlight is seen.
+pub const PROFILE_MAX_THETA_D_DEG: f64 = 15.0;
+/// The diffuse floor is the median of the profile from this theta_h on (degrees).
+pub const FLOOR_MIN_THETA_H_DEG: f64 = 45.0;
+/// A dark hole: the lobe at theta_h ~ 0 below this fraction of its maximum within
+/// [`HOLE_WINDOW_DEG`].
+pub const HOLE_FRACTION: f64 = 0.6;
+/// The theta_h window (degrees) of the maximum a dark hole is judged against.
+pub const HOLE_WINDOW_DEG: f64 = 15.0;
+/// Roughness x2 passes when the HWHM grows by at least this factor.
+pub const WIDEN_MIN_RATIO: f64 = 1.4;
+/// Roughness x0.5 passes when the HWHM shrinks to at most this factor.
+pub const NARROW_MAX_RATIO: f64 = 0.75;
+/// Diffuse x0.5 passes when the floor ends in this range of the original's.
+pub const DIFFUSE_FLOOR_RATIO: (f64, f64) = (0.35, 0.65);
+/// ... and the peak within this relative change ...
+pub const DIFFUSE_PEAK_TOLERANCE: f64 = 0.25;
+/// ... and the peak's colour within this relative change ([`LobeComparison::colour_shift`]).
+pub const DIFFUSE_COLOUR_TOLERANCE: f64 = 0.2;
+
+/// One theta_h sample of the specular profile.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProfileSample {
+    /// The theta_h index (0..90).
+    pub theta_h: usize,
+    /// Its angle in degrees (the bin centre, [`theta_h_of`]).
+    pub theta_h_deg: f64,
+    /// Mean RGB (1/sr) over the valid cells of this theta_h with theta_d <
+    /// [`PROFILE_MAX_THETA_D_DEG`].
+    pub rgb: [f64; 3],
+    /// Luminance of `rgb`.
+    pub luminance: f64,
+}
+
+/// The specular lobe of a table (see the module's definitions).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Lobe {
+    /// The specular profile, theta_h growing, only samples with a valid cell.
+    pub profile: Vec<ProfileSample>,
+    /// The diffuse floor: median luminance of the profile for theta_h >= 45 deg.
+    pub floor: f64,
+    /// The same median per channel.
+    pub floor_rgb: [f64; 3],
+    /// The lobe's maximum (luminance above the floor; <= 0 when there is no lobe).
+    pub peak: f64,
+    /// Where the maximum is: index into `profile`.
+    pub peak_sample: usize,
+    /// theta_h (degrees) of the maximum.
+    pub peak_theta_h_deg: f64,
+    /// The half width at half maximum (degrees), measured from the peak outward; `None` when
+    /// the peak is not above the floor or the lobe never falls below half of it.
+    pub hwhm_deg: Option<f64>,
+    /// RGB chromaticity (summing to 1) of the lobe at the peak; `None` when the lobe's channels
+    /// there do not sum to a positive value.
+    pub peak_colour: Option<[f64; 3]>,
+    /// The lobe at the first profile sample (theta_h ~ 0).
+    pub centre: f64,
+    /// The lobe's maximum over the samples with theta_h <= 15 deg.
+    pub near_max: f64,
+}
+
+impl Lobe {
+    /// Measures the lobe of `table`. Fails when no valid cell has theta_d < 15 deg, none of
+    /// those has theta_h >= 45 deg (no floor) or none has theta_h <= 15 deg (no centre).
+    pub fn of(table: &MerlTable) -> Result<Self> {
+        let profile = specular_profile(table)?;
+        let tail: Vec<&ProfileSample> =
+            profile.iter().filter(|s| s.theta_h_deg >= FLOOR_MIN_THETA_H_DEG).collect();
+        if tail.is_empty() {
+            return Err(EvalError::Invalid(format!(
+                "no valid cell with theta_h >= {FLOOR_MIN_THETA_H_DEG} deg and theta_d < \
+                 {PROFILE_MAX_THETA_D_DEG} deg: the diffuse floor is undefined"
+            )));
+        }
+        if profile[0].theta_h_deg > HOLE_WINDOW_DEG {
+            return Err(EvalError::Invalid(format!(
+                "no valid cell with theta_h <= {HOLE_WINDOW_DEG} deg and theta_d < \
+                 {PROFILE_MAX_THETA_D_DEG} deg: the lobe's centre is undefined"
+            )));
+        }
+        let floor = finite_median(tail.iter().map(|s| s.luminance));
+        let floor_rgb: [f64; 3] =
+            std::array::from_fn(|c| finite_median(tail.iter().map(|s| s.rgb[c])));
+        // Differences within rounding of the floor are no lobe (a flat table has neither a
+        // width nor a dark centre).
+        let rounding = 1e-9 * floor.abs();
+        let lobe: Vec<f64> = profile
+            .iter()
+            .map(|s| s.luminance - floor)
+            .map(|v| if v.abs() <= rounding { 0.0 } else { v })
+            .collect();
+        let (peak_sample, peak) = lobe
+            .iter()
+            .copied()
+            .enumerate()
+            .fold((0, f64::NEG_INFINITY), |best, (i, v)| if v > best.1 { (i, v) } else { best });
+        let hwhm_deg = half_width(&profile, &lobe, peak_sample);
+        let at_peak: [f64; 3] = std::array::from_fn(|c| profile[peak_sample].rgb[c] - floor_rgb[c]);
+        let sum: f64 = at_peak.iter().sum();
+        let peak_colour = (sum > 0.0).then(|| at_peak.map(|v| v / sum));
+        let near_max = profile
+            .iter()
+            .zip(&lobe)
+            .filter(|(s, _)| s.theta_h_deg <= HOLE_WINDOW_DEG)
+            .map(|(_, v)| *v)
+            .fold(f64::NEG_INFINITY, f64::max);
+        Ok(Self {
+            floor,
+            floor_rgb,
+            peak,
+            peak_sample,
+            peak_theta_h_deg: profile[peak_sample].theta_h_deg,
+            hwhm_deg,
+            peak_colour,
+            centre: lobe[0],
+            near_max,
+            profile,
+        })
+    }
+
+    /// Whether the lobe at theta_h ~ 0 is below 60% of its maximum within 15 deg (a dark dot or
+    /// a ring where the highlight should be). A table without a lobe (maximum <= 0) has none.
+    pub fn has_dark_centre(&self) -> bool {
+        self.near_max > 0.0 && self.centre < HOLE_FRACTION * self.near_max
+    }
+}
+
+/// The specular profile of `table` (see [`ProfileSample`]): theta_h samples without a valid
+/// cell at theta_d < 15 deg are left out. Fails when none has one.
+pub fn specular_profile(table: &MerlTable) -> Result<Vec<ProfileSample>> {
+    let d_max = (0..N_THETA_D)
+        .take_while(|&d| theta_d_of(d).to_degrees() < PROFILE_MAX_THETA_D_DEG)
+        .count();
+    let v = table.values();
+    let profile: Vec<ProfileSample> = (0..N_THETA_H)
+        .filter_map(|h| {
+            let mut sum = [0f64; 3];
+            let mut n = 0usize;
+            for d in 0..d_max {
+                for p in 0..N_PHI_D {
+                    let cell = cell_index(h, d, p);
+                    if table.is_valid(cell) {
+                        for (c, s) in sum.iter_mut().enumerate() {
+                            *s += f64::from(v[c * CELLS + cell]);
+                        }
+                        n += 1;
+                    }
+                }
+            }
+            (n > 0).then(|| {
+                let rgb = sum.map(|s| s / n as f64);
+                ProfileSample {
+                    theta_h: h,
+                    theta_h_deg: theta_h_of(h).to_degrees(),
+                    rgb,
+                    luminance: luminance(rgb),
+                }
+            })
+        })
+        .collect();
+    if profile.is_empty() {
+        return Err(EvalError::Invalid(format!(
+            "no valid cell with theta_d < {PROFILE_MAX_THETA_D_DEG} deg: the specular profile \
+             is undefined"
+        )));
+    }
+    Ok(profile)
+}
+
+/// From `lobe[peak]` outward, the theta_h (degrees) of the first crossing below half the peak,
+/// linear between samples, minus the peak's theta_h.
+fn half_width(profile: &[ProfileSample], lobe: &[f64], peak: usize) -> Option<f64> {
+    let half = 0.5 * lobe[peak];
+    if half.is_nan() || half <= 0.0 {
+        return None;
+    }
+    (peak + 1..lobe.len()).find(|&i| lobe[i] < half).map(|i| {
+        let (a, b) = (profile[i - 1].theta_h_deg, profile[i].theta_h_deg);
+        let t = (lobe[i - 1] - half) / (lobe[i - 1] - lobe[i]);
+        a + t * (b - a) - profile[peak].theta_h_deg
+    })
+}
+
+/// How an edited table's lobe compares with the original's. Ratios are edited over original
+/// (NaN where either is undefined or the original's is not positive).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LobeComparison {
+    /// Diffuse floor.
+    pub floor_ratio: f64,
+    /// The lobe's peak.
+    pub peak_ratio: f64,
+    /// The half width at half maximum.
+    pub hwhm_ratio: f64,
+    /// `|c_edited - c_original| / |c_original|` of the peaks' chromaticities (Euclidean over
+    /// the channels).
+    pub colour_shift: f64,
+    /// The edited lobe has a dark centre ([`Lobe::has_dark_centre`]) that the original does
+    /// not.
+    pub dark_hole: bool,
+}
+
+fn ratio(edited: f64, original: f64) -> f64 {
+    match original > 0.0 && edited.is_finite() {
+        true => edited / original,
+        false => f64::NAN,
+    }
+}
+
+/// Compares the lobes (see [`LobeComparison`]).
+pub fn compare(original: &Lobe, edited: &Lobe) -> LobeComparison {
+    let colour_shift = match (original.peak_colour, edited.peak_colour) {
+        (Some(o), Some(e)) => {
+            let d: f64 = o.iter().zip(&e).map(|(a, b)| (a - b).powi(2)).sum();
+            d.sqrt() / o.iter().map(|a| a * a).sum::<f64>().sqrt()
+        }
+        _ => f64::NAN,
+    };
+    LobeComparison {
+        floor_ratio: ratio(edited.floor, original.floor),
+        peak_ratio: ratio(edited.peak, original.peak),
+        hwhm_ratio: ratio(edited.hwhm_deg.unwrap_or(f64::NAN), original.hwhm_deg.unwrap_or(0.0)),
+        colour_shift,
+        dark_hole: dark_hole(original, edited),
+    }
+}
+
+/// Whether `edited` has a dark centre at theta_h ~ 0 that `original` does not.
+pub fn dark_hole(original: &Lobe, edited: &Lobe) -> bool {
+    edited.has_dark_centre() && !original.has_dark_centre()
+}
+
+/// The bar an edit is held to (beside "no dark hole", which every edit is held to).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LobeBar {
+    /// Roughness x2: the HWHM grows >= 1.4x.
+    Widen,
+    /// Roughness x0.5: the HWHM shrinks to <= 0.75x.
+    Narrow,
+    /// Diffuse albedo x0.5: the floor at 0.35-0.65x, the peak within 25%, its colour within
+    /// 20%.
+    HalveDiffuse,
+}
+
+impl LobeBar {
+    /// Every bar, in the order of [`LobeTally::bars`].
+    pub const ALL: [LobeBar; 3] = [LobeBar::Widen, LobeBar::Narrow, LobeBar::HalveDiffuse];
+
+    /// The position of this bar in [`LobeBar::ALL`].
+    pub fn index(self) -> usize {
+        match self {
+            Self::Widen => 0,
+            Self::Narrow => 1,
+            Self::HalveDiffuse => 2,
+        }
+    }
+
+    /// The bar of `edit`: roughness scaled by 2 or 0.5, or the diffuse albedo scaled by 0.5,
+    /// with nothing else changed; `None` for any other edit.
+    pub fn for_edit(edit: &Edit) -> Option<Self> {
+        let is = |s: f64, v: f64| (s - v).abs() < 1e-9;
+        match (edit.diffuse, edit.specular, edit.roughness) {
+            (None, None, Some(ScalarEdit::Scale(s))) if is(s, 2.0) => Some(Self::Widen),
+            (None, None, Some(ScalarEdit::Scale(s))) if is(s, 0.5) => Some(Self::Narrow),
+            (Some(ColourEdit::Scale(s)), None, None) if is(s, 0.5) => Some(Self::HalveDiffuse),
+            _ => None,
+        }
+    }
+
+    /// A one-word name for CSV columns.
+    pub fn key(self) -> &'static str {
+        match self {
+            Self::Widen => "widen",
+            Self::Narrow => "narrow",
+            Self::HalveDiffuse => "halve-diffuse",
+        }
+    }
+
+    /// What the bar asks, for tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Widen => "roughness x2 widens >= 1.4x",
+            Self::Narrow => "roughness x0.5 narrows <= 0.75x",
+            Self::HalveDiffuse => "diffuse x0.5: floor 0.35-0.65x, peak and colour kept",
+        }
+    }
+
+    /// Whether `c` meets this bar (its own condition only; see [`verdict`] for the dark hole).
+    pub fn meets(self, c: &LobeComparison) -> bool {
+        match self {
+            Self::Widen => c.hwhm_ratio >= WIDEN_MIN_RATIO,
+            Self::Narrow => c.hwhm_ratio <= NARROW_MAX_RATIO,
+            Self::HalveDiffuse => {
+                (DIFFUSE_FLOOR_RATIO.0..=DIFFUSE_FLOOR_RATIO.1).contains(&c.floor_ratio)
+                    && (c.peak_ratio - 1.0).abs() <= DIFFUSE_PEAK_TOLERANCE
+                    && c.colour_shift <= DIFFUSE_COLOUR_TOLERANCE
+            }
+        }
+    }
+}
+
+/// The verdict on one edit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LobeVerdict {
+    /// The bar of the edit, if one applies.
+    pub bar: Option<LobeBar>,
+    /// Whether it meets that bar (`None` when no bar applies).
+    pub meets_bar: Option<bool>,
+    /// Whether it left a dark hole.
+    pub dark_hole: bool,
+}
+
+impl LobeVerdict {
+    /// Meets its bar (if any) and leaves no dark hole.
+    pub fn passes(&self) -> bool {
+        self.meets_bar != Some(false) && !self.dark_hole
+    }
+}
+
+/// The verdict on `c`, the comparison of an edit held to `bar`.
+pub fn verdict(bar: Option<LobeBar>, c: &LobeComparison) -> LobeVerdict {
+    LobeVerdict { bar, meets_bar: bar.map(|b| b.meets(c)), dark_hole: c.dark_hole }
+}
+
+/// The lobe measures of one edit: how its lobe compares with the original's and the verdict of
+/// the bar it is held to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EditLobe {
+    pub comparison: LobeComparison,
+    pub verdict: LobeVerdict,
+}
+
+/// Measures the lobe of `edited`, the result of `edit` on a material whose lobe is `original`,
+/// and judges it by the edit's bar ([`LobeBar::for_edit`]). Fails as [`Lobe::of`] does.
+pub fn judge_edit(original: &Lobe, edited: &MerlTable, edit: &Edit) -> Result<EditLobe> {
+    let comparison = compare(original, &Lobe::of(edited)?);
+    Ok(EditLobe { comparison, verdict: verdict(LobeBar::for_edit(edit), &comparison) })
+}
+
+/// How many of a set of edits each bar held, and how many of those met it and passed (met it
+/// without a dark hole).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BarCount {
+    pub held: usize,
+    pub met: usize,
+    pub passed: usize,
+}
+
+/// Counts over a set of edits' verdicts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LobeTally {
+    /// Edits counted.
+    pub edits: usize,
+    /// Edits that left a dark hole.
+    pub dark_holes: usize,
+    /// Per bar, in the order [`LobeBar::ALL`].
+    pub bars: [BarCount; 3],
+}
+
+impl LobeTally {
+    /// Counts `verdicts`.
+    pub fn of<'a>(verdicts: impl IntoIterator<Item = &'a LobeVerdict>) -> Self {
+        let mut t = Self::default();
+        for v in verdicts {
+            t.edits += 1;
+            t.dark_holes += usize::from(v.dark_hole);
+            if let Some(bar) = v.bar {
+                let count = &mut t.bars[bar.index()];
+                count.held += 1;
+                count.met += usize::from(v.meets_bar == Some(true));
+                count.passed += usize::from(v.passes());
+            }
+        }
+        t
+    }
+
+    /// The count of `bar`.
+    pub fn bar(&self, bar: LobeBar) -> BarCount {
+        self.bars[bar.index()]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use deepbrdf_data::ggx::{ggx, Ggx};
+    use deepbrdf_data::merl::coords::HalfDiff;
+    use deepbrdf_data::merl::{INVALID_VALUE, VALUES};
+    use deepbrdf_data::testing::tabulate;
+    use std::f64::consts::PI;
+
+    /// Lambertian `diffuse` + GGX (`alpha`, Schlick `f0`) times `lobe_scale`, tabulated at the
+    /// cells' sample angles; the GGX part is zero below `hole_deg` of theta_h.
+    fn table(alpha: f64, f0: f64, diffuse: [f64; 3], lobe_scale: f64, hole_deg: f64) -> MerlTable {
+        let spec = Ggx { alpha, f0: [f0; 3], diffuse: [0.0; 3] };
+        tabulate(|wi, wo| {
+            let s = match HalfDiff::from_dirs(wi, wo).theta_h.to_degrees() < hole_deg {
+                true => [0.0; 3],
+                false => ggx(&spec, wi, wo),
+            };
+            std::array::from_fn(|c| diffuse[c] / PI + lobe_scale * s[c])
+        })
+    }
+
+    fn lobe_of(table: &MerlTable) -> Lobe {
+        match Lobe::of(table) {
+            Ok(l) => l,
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    /// The lobe of [`table`].
+    fn material(alpha: f64, f0: f64, diffuse: [f64; 3], lobe_scale: f64, hole_deg: f64) -> Lobe {
+        lobe_of(&table(alpha, f0, diffuse, lobe_scale, hole_deg))
+    }
+
+    const ALBEDO: [f64; 3] = [0.6, 0.4, 0.2];
+
+    #[test]
+    fn lobe_hwhm_grows_with_alpha_and_the_floor_is_the_albedo() {
+        let alphas = [0.02, 0.05, 0.1, 0.2, 0.4];
+        let lobes: Vec<Lobe> =
+            alphas.iter().map(|&a| material(a, 0.04, ALBEDO, 1.0, 0.0)).collect();
+        let widths: Vec<f64> = lobes.iter().map(|l| l.hwhm_deg.unwrap_or(f64::NAN)).collect();
+        assert!(widths.windows(2).all(|w| w[1] > w[0]), "{widths:?}");
+        // GGX's D falls to half its peak at tan^2 theta_h = (sqrt 2 - 1) alpha^2 for small
+        // alpha (solve ((alpha^2 - 1) c^2 + 1)^2 = 2 alpha^4): theta_h ~ 0.644 alpha rad, so the
+        // width doubles with alpha.
+        for (a, w) in alphas.iter().zip(&widths).take(3) {
+            let expected = (((2f64).sqrt() - 1.0).sqrt() * a).atan().to_degrees();
+            assert!((w / expected - 1.0).abs() < 0.2, "alpha {a}: {w} vs {expected}");
+        }
+        for i in 0..2 {
+            let r = widths[i + 2] / widths[i + 1];
+            assert!((1.7..2.3).contains(&r), "alpha x2 from {}: width x{r}", alphas[i + 1]);
+        }
+        // The floor is the Lambertian albedo / pi (the lobe's tail above 45 deg adds little).
+        let want = luminance(ALBEDO.map(|a| a / PI));
+        for (a, l) in alphas.iter().zip(&lobes).take(4) {
+            assert!((l.floor / want - 1.0).abs() < 0.03, "alpha {a}: {} vs {want}", l.floor);
+            assert!(l.peak_theta_h_deg < 0.1 && !l.has_dark_centre(), "{a}");
+            // The lobe (f0 grey) is white.
+            let colour = l.peak_colour.unwrap_or([0.0; 3]);
+            assert!(colour.iter().all(|c| (c - 1.0 / 3.0).abs() < 0.01), "{colour:?}");
+        }
+    }
+
+    #[test]
+    fn a_zeroed_centre_is_a_dark_hole_and_the_bars_judge_the_edits() {
+        let original = material(0.1, 0.04, ALBEDO, 1.0, 0.0);
+        let holed = material(0.1, 0.04, ALBEDO, 1.0, 3.0);
+        assert!(holed.has_dark_centre() && holed.peak_theta_h_deg >= 3.0, "{holed:?}");
+        assert!(dark_hole(&original, &holed));
+        assert!(!dark_hole(&original, &original) && !dark_hole(&holed, &holed));
+        assert!(compare(&original, &holed).dark_hole);
+
+        let same = compare(&original, &original);
+        assert_eq!((same.floor_ratio, same.peak_ratio, same.hwhm_ratio), (1.0, 1.0, 1.0));
+        assert!(
+            verdict(None, &same).passes() && !verdict(None, &compare(&original, &holed)).passes()
+        );
+
+        let halve = Edit { diffuse: Some(ColourEdit::Scale(0.5)), ..Edit::default() };
+        let bar = LobeBar::for_edit(&halve);
+        assert_eq!(bar, Some(LobeBar::HalveDiffuse));
+        let halved = compare(&original, &material(0.1, 0.04, ALBEDO.map(|a| a / 2.0), 1.0, 0.0));
+        assert!((halved.floor_ratio - 0.5).abs() < 0.02, "{halved:?}");
+        assert!((halved.peak_ratio - 1.0).abs() < 0.02, "{halved:?}");
+        let v = verdict(bar, &halved);
+        assert!(v.meets_bar == Some(true) && v.passes(), "{v:?}");
+        let doubled = compare(&original, &material(0.1, 0.04, ALBEDO.map(|a| a / 2.0), 2.0, 0.0));
+        let v = verdict(bar, &doubled);
+        assert!(v.meets_bar == Some(false) && !v.passes(), "{doubled:?}");
+        // A lobe turned red at the same luminance (Rec. 709 red weight 0.2126) over a halved
+        // floor fails on its colour alone.
+        let tinted = MerlTable::from_fn(|h, _, _| {
+            let d = deepbrdf_data::ggx::distribution(0.1, theta_h_of(h).cos());
+            [(0.1 / PI + 0.1 / 0.2126 * d) as f32, (0.1 / PI) as f32, (0.1 / PI) as f32]
+        });
+        let grey = MerlTable::from_fn(|h, _, _| {
+            let d = deepbrdf_data::ggx::distribution(0.1, theta_h_of(h).cos()) as f32;
+            [0.2 / PI as f32 + 0.1 * d; 3]
+        });
+        let c = compare(&lobe_of(&grey), &lobe_of(&tinted));
+        assert!((c.floor_ratio - 0.5).abs() < 0.01 && (c.peak_ratio - 1.0).abs() < 0.01, "{c:?}");
+        assert!(c.colour_shift > DIFFUSE_COLOUR_TOLERANCE && !LobeBar::HalveDiffuse.meets(&c));
+
+        let wide = compare(&original, &material(0.2, 0.04, ALBEDO, 1.0, 0.0));
+        let narrow = compare(&original, &material(0.05, 0.04, ALBEDO, 1.0, 0.0));
+        assert!(LobeBar::Widen.meets(&wide) && !LobeBar::Narrow.meets(&wide), "{wide:?}");
+        assert!(LobeBar::Narrow.meets(&narrow) && !LobeBar::Widen.meets(&narrow), "{narrow:?}");
+        let rough = |s| Edit { roughness: Some(ScalarEdit::Scale(s)), ..Edit::default() };
+        assert_eq!(LobeBar::for_edit(&rough(2.0)), Some(LobeBar::Widen));
+        assert_eq!(LobeBar::for_edit(&rough(0.5)), Some(LobeBar::Narrow));
+        assert_eq!(LobeBar::for_edit(&rough(1.5)), None);
+        assert_eq!(LobeBar::for_edit(&Edit::default()), None);
+    }
+
+    #[test]
+    fn tables_without_the_needed_cells_are_errors() {
+        let empty = MerlTable::from_values(vec![INVALID_VALUE; VALUES]);
+        let empty = match empty {
+            Ok(t) => t,
+            Err(e) => panic!("{e}"),
+        };
+        assert!(matches!(Lobe::of(&empty), Err(EvalError::Invalid(_))));
+        assert!(specular_profile(&empty).is_err());
+        // Valid only below 45 deg of theta_h: no floor.
+        let mut low = MerlTable::from_fn(|_, _, _| [0.1; 3]);
+        let cut = cell_index(N_THETA_H * 2 / 3, 0, 0);
+        for c in 0..3 {
+            low.values_mut()[c * CELLS + cut..(c + 1) * CELLS].fill(INVALID_VALUE);
+        }
+        assert!(Lobe::of(&low).is_err());
+        // A lobe-less table is measured: no peak above the floor, no width, no hole.
+        let flat = lobe_of(&MerlTable::from_fn(|_, _, _| [0.1; 3]));
+        assert!(flat.peak.abs() < 1e-6 && flat.hwhm_deg.is_none() && !flat.has_dark_centre());
+    }
+
+    #[test]
+    fn judge_edit_and_tally_a_hand_made_pair() {
+        let original = table(0.1, 0.04, ALBEDO, 1.0, 0.0);
+        let lobe = lobe_of(&original);
+        let rough = |s| Edit { roughness: Some(ScalarEdit::Scale(s)), ..Edit::default() };
+        let judge = |edited: &MerlTable, edit: &Edit| match judge_edit(&lobe, edited, edit) {
+            Ok(j) => j,
+            Err(e) => panic!("{e}"),
+        };
+        let wide = judge(&table(0.2, 0.04, ALBEDO, 1.0, 0.0), &rough(2.0));
+        // Wider still, but dark at the centre: meets the bar and fails.
+        let holed = judge(&table(0.4, 0.04, ALBEDO, 1.0, 3.0), &rough(2.0));
+        let narrow = judge(&table(0.05, 0.04, ALBEDO, 1.0, 0.0), &rough(0.5));
+        let identity = judge(&original, &Edit::default());
+        assert!(wide.verdict.passes() && narrow.verdict.passes(), "{wide:?} {narrow:?}");
+        assert_eq!(holed.verdict.meets_bar, Some(true), "{holed:?}");
+        assert!(holed.verdict.dark_hole && !holed.verdict.passes());
+        assert_eq!(identity.verdict, LobeVerdict { bar: None, meets_bar: None, dark_hole: false });
+        let all = [wide, holed, narrow, identity];
+        let tally = LobeTally::of(all.iter().map(|j| &j.verdict));
+        assert_eq!((tally.edits, tally.dark_holes), (4, 1));
+        assert_eq!(tally.bar(LobeBar::Widen), BarCount { held: 2, met: 2, passed: 1 });
+        assert_eq!(tally.bar(LobeBar::Narrow), BarCount { held: 1, met: 1, passed: 1 });
+        assert_eq!(tally.bar(LobeBar::HalveDiffuse), BarCount::default());
+        let empty = MerlTable::from_values(vec![INVALID_VALUE; VALUES]);
+        assert!(empty.map(|t| judge_edit(&lobe, &t, &rough(2.0)).is_err()).unwrap_or(false));
+    }
+}
