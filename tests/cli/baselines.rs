@@ -161,3 +161,44 @@ fn baselines_write_the_same_bytes_with_one_thread_and_with_several() {
     }
     assert!(csv[0] == csv[1], "results.csv differs between 1 and 3 threads");
 }
+
+#[test]
+fn folds_lists_the_materials_each_fold_of_baselines_scores() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("data");
+    write_materials(&data, 7);
+    let d = data.to_str().unwrap();
+    let out = util::run_in(
+        dir.path(),
+        &[
+            "baselines",
+            "--mode",
+            "kfold:3",
+            "--k",
+            "1",
+            "--methods",
+            "pca",
+            "--measures",
+            "mapped_mse",
+            "--data",
+            d,
+            "--out",
+            "res",
+        ],
+    );
+    assert!(out.status.success(), "{}", util::stderr(&out));
+    let csv = std::fs::read_to_string(dir.path().join("res").join("results.csv")).unwrap();
+    let mut scored: Vec<String> =
+        csv.lines().skip(1).map(|l| l.split(',').collect::<Vec<_>>()[2..4].join("\t")).collect();
+    scored.sort();
+    let out = util::run_in(dir.path(), &["folds", "--mode", "kfold:3", "--data", d]);
+    assert!(out.status.success(), "{}", util::stderr(&out));
+    let mut listed: Vec<String> = util::stdout(&out).lines().map(str::to_string).collect();
+    listed.sort();
+    assert_eq!(listed, scored, "every material once, in the fold baselines scored it in");
+    let out = util::run_in(dir.path(), &["folds", "--mode", "kfold:3", "--fold", "1", "--data", d]);
+    let fold1: Vec<String> = util::stdout(&out).lines().map(|m| format!("1\t{m}")).collect();
+    assert!(!fold1.is_empty() && fold1.iter().all(|l| scored.contains(l)), "{fold1:?}");
+    let out = util::run_in(dir.path(), &["folds", "--mode", "kfold:3", "--fold", "3", "--data", d]);
+    util::assert_clean_failure(&out, "folds 0 to 2");
+}

@@ -27,6 +27,8 @@ pub enum Command {
     /// Describe a MERL table: a .binary file or a bundled material (header, valid cells,
     /// per-channel statistics, albedo at normal incidence).
     Info(commands::info::Args),
+    /// The materials each fold of the k-fold split scores (`--fold F`: one fold, a name a line).
+    Folds(commands::folds::Args),
     /// Write MERL .binary files tabulated from the bundled NBRDF networks.
     Tabulate(commands::tabulate::Args),
     /// Pack folders of JSON NBRDF networks into the bundled .nbrdf files.

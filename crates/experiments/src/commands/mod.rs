@@ -15,6 +15,7 @@ pub mod fetch_merl;
 pub mod figures_editing;
 pub mod figures_generalize;
 pub mod figures_recovery;
+pub mod folds;
 pub mod info;
 pub mod interpolate;
 pub mod pack_nbrdf;
@@ -38,6 +39,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Bench(args) => bench::run(args, &progress),
         Command::FetchMerl(args) => fetch_merl::run(args, cli.quiet),
         Command::Info(args) => info::run(args, &progress),
+        Command::Folds(args) => folds::run(args, &progress),
         Command::Tabulate(args) => tabulate::run(args, &progress),
         Command::PackNbrdf(args) => pack_nbrdf::run(args, &progress),
         Command::Train(args) => train::run(args, &progress),
