@@ -17,6 +17,10 @@
 //! | 8                | number of values, u64 little-endian (= [`VALUES`])    |
 //! | 4 x values       | the values, f32 little-endian, channel-major MERL order |
 //! | 32               | SHA-256 of all preceding bytes                        |
+//!
+//! [`MedianReference::save_compressed`] writes the same bytes as one zstd frame (lossless: the
+//! values and their checksum are unchanged); [`MedianReference::load`] reads either form,
+//! telling them apart by their first bytes.
 
 use crate::error::{DataError, Result};
 use crate::files::{open_regular, read_exactly, write_atomic};
@@ -41,6 +45,13 @@ const CHECKSUM_BYTES: usize = 32;
 const FILE_BYTES: usize = HEADER_BYTES + 4 * VALUES + CHECKSUM_BYTES;
 /// Values per parallel work item.
 const CHUNK: usize = 16 * 1024;
+/// The first bytes of a zstd frame.
+const ZSTD_MAGIC: [u8; 4] = [0x28, 0xB5, 0x2F, 0xFD];
+/// zstd's level for [`MedianReference::save_compressed`]: higher levels shrink the file by a few
+/// percent more and take seconds instead of a fraction of one.
+const ZSTD_LEVEL: i32 = 3;
+/// The largest compressed file read: zstd adds a little to incompressible data, never this much.
+const MAX_COMPRESSED_BYTES: u64 = FILE_BYTES as u64 + (1 << 20);
 
 /// Eq. (1) for one value: `ln((rho + eps) / (rho_ref + eps) + 1)`.
 #[inline]
@@ -193,6 +204,20 @@ impl MedianReference {
 
     /// Saves the reference to `path` (format in the module documentation), atomically.
     pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
+        write_atomic(path.as_ref(), &self.to_bytes())
+    }
+
+    /// Saves the reference to `path` as one zstd frame of the bytes [`Self::save`] writes,
+    /// atomically; [`Self::load`] reads it back to the same values.
+    pub fn save_compressed(&self, path: impl AsRef<Path>) -> Result<()> {
+        let path = path.as_ref();
+        let packed = zstd::bulk::compress(&self.to_bytes(), ZSTD_LEVEL)
+            .map_err(|e| DataError::io(path, e))?;
+        write_atomic(path, &packed)
+    }
+
+    /// The file format's bytes (module documentation).
+    fn to_bytes(&self) -> Vec<u8> {
         let mut bytes = Vec::with_capacity(FILE_BYTES);
         bytes.extend_from_slice(MAGIC);
         bytes.extend_from_slice(&VERSION.to_le_bytes());
@@ -202,12 +227,14 @@ impl MedianReference {
         }
         let digest = Sha256::digest(&bytes);
         bytes.extend_from_slice(&digest);
-        write_atomic(path.as_ref(), &bytes)
+        bytes
     }
 
-    /// Loads a reference saved by [`Self::save`]. Every malformed file (empty, truncated, other
-    /// magic, version or length, trailing bytes, checksum mismatch, invalid values) is an error
-    /// naming the file; nothing is allocated before the file's size has been checked.
+    /// Loads a reference saved by [`Self::save`] or [`Self::save_compressed`]. Every malformed
+    /// file (empty, truncated, other magic, version or length, trailing bytes, checksum
+    /// mismatch, invalid values, a damaged or oversized zstd frame) is an error naming the
+    /// file; nothing is allocated before the file's size has been checked, and a compressed
+    /// file is never inflated past the size of the format.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
         let (mut file, len) = open_regular(path)?;
@@ -216,37 +243,22 @@ impl MedianReference {
         }
         let mut header = [0u8; HEADER_BYTES];
         let got = read_prefix(&mut file, path, &mut header)?;
-        if got < MAGIC.len() || &header[..8] != MAGIC {
-            return Err(DataError::format(
-                path,
-                "not a median reference file (it does not start with DBRDFMED)",
-            ));
+        if got >= ZSTD_MAGIC.len() && header[..4] == ZSTD_MAGIC {
+            if len > MAX_COMPRESSED_BYTES {
+                return Err(DataError::format(
+                    path,
+                    format!("{len} bytes: too large for a compressed median reference"),
+                ));
+            }
+            let mut packed = header[..got].to_vec();
+            file.read_to_end(&mut packed).map_err(|e| DataError::io(path, e))?;
+            // Inflating stops with an error past the format's size: no bomb is expanded.
+            let raw = zstd::bulk::decompress(&packed, FILE_BYTES).map_err(|e| {
+                DataError::format(path, format!("a damaged compressed median reference: {e}"))
+            })?;
+            return Self::from_file_bytes(path, &raw);
         }
-        if got < HEADER_BYTES {
-            return Err(DataError::format(path, format!("truncated: {len} bytes")));
-        }
-        let version = u32::from_le_bytes([header[8], header[9], header[10], header[11]]);
-        if version != VERSION {
-            return Err(DataError::format(
-                path,
-                format!("median reference format version {version}, this build reads {VERSION}"),
-            ));
-        }
-        let mut n = [0u8; 8];
-        n.copy_from_slice(&header[12..20]);
-        let n = u64::from_le_bytes(n);
-        if n != VALUES as u64 {
-            return Err(DataError::format(
-                path,
-                format!("holds {n} values, a median reference has {VALUES}"),
-            ));
-        }
-        if len < FILE_BYTES as u64 {
-            return Err(DataError::format(
-                path,
-                format!("truncated: {len} bytes, expected {FILE_BYTES}"),
-            ));
-        }
+        check_header(path, &header[..got], len as usize)?;
         if len > FILE_BYTES as u64 {
             return Err(DataError::format(
                 path,
@@ -256,18 +268,69 @@ impl MedianReference {
                 ),
             ));
         }
-        let rest = read_exactly(&mut file, path, FILE_BYTES - HEADER_BYTES)?;
-        let (body, checksum) = rest.split_at(rest.len() - CHECKSUM_BYTES);
-        let mut hasher = Sha256::new();
-        hasher.update(header);
-        hasher.update(body);
-        if hasher.finalize().as_slice() != checksum {
+        let mut bytes = header[..got].to_vec();
+        bytes.extend(read_exactly(&mut file, path, len as usize - got)?);
+        Self::from_file_bytes(path, &bytes)
+    }
+
+    /// The reference in `bytes`, the whole of a file in the format of [`Self::save`] (read
+    /// from `path`, which errors name).
+    fn from_file_bytes(path: &Path, bytes: &[u8]) -> Result<Self> {
+        let len = bytes.len();
+        check_header(path, &bytes[..len.min(HEADER_BYTES)], len)?;
+        if len < FILE_BYTES {
+            return Err(DataError::format(
+                path,
+                format!("truncated: {len} bytes, expected {FILE_BYTES}"),
+            ));
+        }
+        if len > FILE_BYTES {
+            return Err(DataError::format(
+                path,
+                format!("{} trailing bytes after the expected {FILE_BYTES}", len - FILE_BYTES),
+            ));
+        }
+        let (content, checksum) = bytes.split_at(len - CHECKSUM_BYTES);
+        if Sha256::digest(content).as_slice() != checksum {
             return Err(DataError::format(path, "checksum mismatch: the file is corrupted"));
         }
-        let values: Vec<f32> =
-            body.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+        let values: Vec<f32> = content[HEADER_BYTES..]
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
         Self::from_values(values).map_err(|e| DataError::format(path, e.to_string()))
     }
+}
+
+/// Checks the start of a reference file (`header`: its first bytes, up to [`HEADER_BYTES`];
+/// `len`: the whole file's length): magic, version and number of values.
+fn check_header(path: &Path, header: &[u8], len: usize) -> Result<()> {
+    if header.len() < MAGIC.len() || &header[..8] != MAGIC {
+        return Err(DataError::format(
+            path,
+            "not a median reference file (it does not start with DBRDFMED)",
+        ));
+    }
+    if header.len() < HEADER_BYTES {
+        return Err(DataError::format(path, format!("truncated: {len} bytes")));
+    }
+    let version = u32::from_le_bytes([header[8], header[9], header[10], header[11]]);
+    if version != VERSION {
+        return Err(DataError::format(
+            path,
+            format!("median reference format version {version}, this build reads {VERSION}"),
+        ));
+    }
+    let mut n = [0u8; 8];
+    n.copy_from_slice(&header[12..20]);
+    let n = u64::from_le_bytes(n);
+    if n != VALUES as u64 {
+        return Err(DataError::format(
+            path,
+            format!("holds {n} values, a median reference has {VALUES}"),
+        ));
+    }
+    Ok(())
 }
 
 /// Reads up to `buf.len()` bytes from the start of `file`; returns how many were read.
@@ -478,6 +541,20 @@ mod tests {
         let digest = Sha256::digest(&nan);
         nan.extend_from_slice(&digest);
         check(&nan, "value 0")?;
+        // The compressed form: the same values back; damaged, oversized or foreign frames are
+        // errors naming the file.
+        let packed = dir.path().join("median.bin.zst");
+        reference.save_compressed(&packed)?;
+        assert!(std::fs::metadata(&packed)?.len() < FILE_BYTES as u64 / 2);
+        assert_eq!(MedianReference::load(&packed)?, reference);
+        let frame = std::fs::read(&packed)?;
+        check(&frame[..frame.len() / 2], "damaged compressed")?;
+        let bomb = zstd::bulk::compress(&vec![0u8; 4 * FILE_BYTES], 3)?;
+        check(&bomb, "damaged compressed")?;
+        check(&zstd::bulk::compress(b"hello world", 3)?, "DBRDFMED")?;
+        let mut flipped_inside = good.clone();
+        flipped_inside[HEADER_BYTES + 7] ^= 1;
+        check(&zstd::bulk::compress(&flipped_inside, 3)?, "checksum")?;
         let msg = MedianReference::load(dir.path()).err().map(|e| e.to_string());
         assert!(msg.unwrap_or_default().contains("directory"));
         let msg =

@@ -5,7 +5,8 @@
 //! model/
 //!   model.json             id, network configuration, training provenance, part checksums
 //!   weights.bpk            the network's parameters (burnpack, Burn's record format)
-//!   median_reference.bin   the eq. (1) reference of the training data (deepbrdf-data format)
+//!   median_reference.bin   the eq. (1) reference of the training data (deepbrdf-data format,
+//!                          written zstd-compressed)
 //!   basis.f16              spectral-only networks (the `cpu` preset): the basis, compact
 //!                          (crate::compact: its support, f16); weights.bpk then lacks it
 //! ```
@@ -296,7 +297,7 @@ impl ModelArtifact {
         if let Some(basis) = &self.basis {
             write_atomic(&dir.join(BASIS_FILE), &[basis])?;
         }
-        self.reference.save(dir.join(REFERENCE_FILE))?;
+        self.reference.save_compressed(dir.join(REFERENCE_FILE))?;
         let manifest = Manifest {
             format: FORMAT.into(),
             version: VERSION,
