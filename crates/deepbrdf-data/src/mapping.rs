@@ -252,11 +252,7 @@ impl MedianReference {
             }
             let mut packed = header[..got].to_vec();
             file.read_to_end(&mut packed).map_err(|e| DataError::io(path, e))?;
-            // Inflating stops with an error past the format's size: no bomb is expanded.
-            let raw = zstd::bulk::decompress(&packed, FILE_BYTES).map_err(|e| {
-                DataError::format(path, format!("a damaged compressed median reference: {e}"))
-            })?;
-            return Self::from_file_bytes(path, &raw);
+            return Self::from_compressed(path, &packed);
         }
         check_header(path, &header[..got], len as usize)?;
         if len > FILE_BYTES as u64 {
@@ -271,6 +267,16 @@ impl MedianReference {
         let mut bytes = header[..got].to_vec();
         bytes.extend(read_exactly(&mut file, path, len as usize - got)?);
         Self::from_file_bytes(path, &bytes)
+    }
+
+    /// The reference in `packed`, a file written by [`Self::save_compressed`] (read from
+    /// `path`, which errors name). Inflating stops with an error past the format's size, so no
+    /// frame is expanded beyond it.
+    fn from_compressed(path: &Path, packed: &[u8]) -> Result<Self> {
+        let raw = zstd::bulk::decompress(packed, FILE_BYTES).map_err(|e| {
+            DataError::format(path, format!("a damaged compressed median reference: {e}"))
+        })?;
+        Self::from_file_bytes(path, &raw)
     }
 
     /// The reference in `bytes`, the whole of a file in the format of [`Self::save`] (read
@@ -557,6 +563,26 @@ mod tests {
         check(&zstd::bulk::compress(&flipped_inside, 3)?, "checksum")?;
         let msg = MedianReference::load(dir.path()).err().map(|e| e.to_string());
         assert!(msg.unwrap_or_default().contains("directory"));
+        Ok(())
+    }
+
+    #[test]
+    fn mutated_compressed_references_are_rejected_or_read_never_a_panic() -> TestResult {
+        use crate::testing::mutate::{fuzz, inputs, Focus};
+        let reference =
+            MedianReference::from_values((0..VALUES).map(|i| (i % 541) as f32 * 0.021).collect())?;
+        let dir = tempfile::tempdir()?;
+        let path = dir.path().join("median.bin");
+        reference.save_compressed(&path)?;
+        let corpus = vec![std::fs::read(&path)?];
+        let origin = Path::new("fuzz.bin");
+        // Each accepted input inflates to 17.5 MB and is hashed: fewer inputs than the others.
+        let report = fuzz(&corpus, 13, inputs(300), Focus::default(), |b| {
+            MedianReference::from_compressed(origin, b)
+        });
+        eprintln!("compressed median reference reader: {report:?}");
+        assert!(report.panics.is_empty(), "panics: {:?}", report.panics);
+        assert!(report.rejected > 0, "{report:?}");
         let msg =
             MedianReference::load(dir.path().join("missing.bin")).err().map(|e| e.to_string());
         assert!(msg.unwrap_or_default().contains("missing.bin"));
