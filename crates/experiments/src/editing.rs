@@ -1,20 +1,22 @@
-//! The edits and interpolations of §5.1 (Hu et al. 2020) on a representation with a regressor
-//! (eq. (7)): a DeepBRDF model or an IPCA basis ([`Codec`]) and the regressor trained for it.
-//! One home for what `edit`, `interpolate`, `figures-editing` and `bench edit` share: the
-//! paper's edit `Y' = Phi(alpha')`, the residual edit `Y' = Y + Phi(alpha') - Phi(alpha)`, the
-//! latent blend, and where a model's regressors live.
+//! What the editing commands (`edit`, `interpolate`, `figures-editing`, `serve`, `bench edit`)
+//! share on the command line: the model and regressor options, where a model's regressors live
+//! and how they load. The edits themselves (§5.1, eq. (7)) are the library's
+//! ([`deepbrdf_eval::editing::space`]), re-exported here.
+use crate::commands::train_regressor::{self, IPCA_BASIS_FILE};
 use crate::model_arg::ModelArg;
 use anyhow::{bail, Context};
-use deepbrdf_data::MerlTable;
+use deepbrdf_data::dataset::Dataset;
+use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::attributes::{self, Attributes, FitConfig};
-use deepbrdf_eval::baseline::BaselineBasis;
-use deepbrdf_eval::editing::Edit;
-use deepbrdf_eval::harness::Codec;
+use deepbrdf_eval::baseline::{BaselineBasis, BaselineCodec, MappingKind};
+pub use deepbrdf_eval::editing::{blend, blend_tables, EditMode, ModelCodec, Space, DEFAULT_MODE};
+use deepbrdf_eval::harness::Codec as _;
 use deepbrdf_model::burn::tensor::Device;
-use deepbrdf_model::regressor::{Regressor, TargetKind};
+use deepbrdf_model::regressor::{Regressor, RegressorData, Target, TargetKind};
 use deepbrdf_model::DeepBrdf;
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// The options naming what the editing commands (`edit`, `figures-editing`, `serve`, `bench
 /// edit`, `bench serve`) edit with: the model (`--model DIR`) and its regressor.
@@ -30,122 +32,11 @@ pub struct EditorArg {
 /// Name of the folder holding a model's regressors, inside the model directory.
 pub const REGRESSOR_DIR: &str = "regressor";
 
-/// Which edit.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum EditMode {
-    /// The paper's edit: the latent of the edited attributes, `Y' = Phi(alpha')`.
-    Paper,
-    /// Keeps what the attributes do not explain: `Y' = Y + Phi(alpha') - Phi(alpha)`.
-    Residual,
-}
-
-impl EditMode {
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Paper => "paper",
-            Self::Residual => "residual",
-        }
-    }
-}
-
-/// The default `--mode`: the residual edit. In the `figures-editing` suite (README, "Editing")
-/// the two are close on the edits themselves (each ahead on some rows), and the residual edit
-/// keeps an unedited material as it is (identity image RelAE 0.001 against 0.053).
-pub const DEFAULT_MODE: EditMode = EditMode::Residual;
-
-/// A DeepBRDF model as a [`Codec`] (eq. (2) to encode, eq. (3) to decode).
-pub struct ModelCodec<'a>(pub &'a DeepBrdf);
-
-impl Codec for ModelCodec<'_> {
-    fn name(&self) -> String {
-        format!("DeepBRDF-{}", self.0.k())
-    }
-
-    fn k(&self) -> usize {
-        self.0.k()
-    }
-
-    fn encode(&self, table: &MerlTable) -> deepbrdf_eval::Result<Vec<f32>> {
-        self.0.encode(table).map_err(|e| deepbrdf_eval::EvalError::method(self.name(), e))
-    }
-
-    fn decode(&self, code: &[f32]) -> deepbrdf_eval::Result<MerlTable> {
-        self.0.decode(code).map_err(|e| deepbrdf_eval::EvalError::method(self.name(), e))
-    }
-}
-
-/// A representation and its regressor.
-pub struct Space<'a> {
-    pub codec: &'a dyn Codec,
-    pub regressor: &'a Regressor,
-}
-
-/// An edit's result.
-pub struct Edited {
-    /// The attributes asked for.
-    pub requested: Attributes,
-    pub table: MerlTable,
-}
-
-impl Space<'_> {
-    /// Eq. (7): the latent of `a`.
-    pub fn latent_of(&self, a: &Attributes) -> anyhow::Result<Vec<f32>> {
-        Ok(self.regressor.predict(&a.to_array())?)
-    }
-
-    /// Edits `table`, whose attributes are `original` (and latent `latent`, for the residual
-    /// edit), by `edit` in `mode`.
-    pub fn edit(
-        &self,
-        latent: &[f32],
-        original: &Attributes,
-        edit: &Edit,
-        mode: EditMode,
-    ) -> anyhow::Result<Edited> {
-        let requested = edit.apply(original)?;
-        let latent = self.edited_latent(latent, original, &requested, mode)?;
-        let table = self.codec.decode(&latent)?;
-        Ok(Edited { requested, table })
-    }
-
-    /// The latent of the edit from `original` (latent `latent`, used by the residual edit) to
-    /// the attributes `requested` (checked by [`Edit::apply`]), before decoding.
-    pub fn edited_latent(
-        &self,
-        latent: &[f32],
-        original: &Attributes,
-        requested: &Attributes,
-        mode: EditMode,
-    ) -> anyhow::Result<Vec<f32>> {
-        let target = self.latent_of(requested)?;
-        Ok(match mode {
-            EditMode::Paper => target,
-            EditMode::Residual => {
-                let base = self.latent_of(original)?;
-                latent.iter().zip(target.iter().zip(&base)).map(|(y, (t, b))| y + t - b).collect()
-            }
-        })
-    }
-}
-
-/// `(1 - t) a + t b`.
-pub fn blend(a: &[f32], b: &[f32], t: f64) -> Vec<f32> {
-    a.iter().zip(b).map(|(&x, &y)| ((1.0 - t) * f64::from(x) + t * f64::from(y)) as f32).collect()
-}
-
-/// The plain linear blend of two tables (the reference path of `interpolate`): valid cells of
-/// both blended, the others invalid.
-pub fn blend_tables(a: &MerlTable, b: &MerlTable, t: f64) -> anyhow::Result<MerlTable> {
-    let values: Vec<f32> = a
-        .values()
-        .iter()
-        .zip(b.values())
-        .map(|(&x, &y)| match x < 0.0 || y < 0.0 {
-            true => deepbrdf_data::merl::INVALID_VALUE,
-            false => ((1.0 - t) * f64::from(x) + t * f64::from(y)) as f32,
-        })
-        .collect();
-    Ok(MerlTable::from_values(values)?)
+/// The `--mode` option's parser: `paper` or `residual` ([`EditMode`]).
+pub fn mode_parser() -> impl clap::builder::TypedValueParser<Value = EditMode> {
+    use clap::builder::TypedValueParser as _;
+    clap::builder::PossibleValuesParser::new(EditMode::ALL.map(EditMode::name))
+        .map(|s| s.parse().expect("a listed edit mode parses"))
 }
 
 /// The fit used to re-estimate the attributes of decoded tables in the measures: the
@@ -163,6 +54,27 @@ pub fn attributes_of(
     Ok(attributes::fit(table, config)
         .with_context(|| format!("fitting the attributes of {name}"))?
         .attributes)
+}
+
+/// The attributes of every material of `set` (the library's fit), with progress.
+pub fn attributes_of_all(
+    set: &Dataset,
+    config: &FitConfig,
+    progress: &dyn Progress,
+) -> anyhow::Result<Vec<Attributes>> {
+    progress.start(set.len() as u64, "attributes");
+    let attrs = set
+        .names
+        .iter()
+        .zip(&set.tables)
+        .map(|(name, t)| {
+            let a = attributes_of(t, name, config);
+            progress.advance(1);
+            a
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    progress.finish();
+    Ok(attrs)
 }
 
 /// The regressor directory of a model directory: `--regressor DIR` if given, else
@@ -203,4 +115,50 @@ pub fn ipca_owner_id(basis: &BaselineBasis, k: usize) -> String {
     h.update((basis.basis().k() as u64).to_le_bytes());
     basis.basis().components().iter().for_each(|v| h.update(v.to_le_bytes()));
     hex::encode(&h.finalize()[..16])
+}
+
+/// IPCA at `k` over `set` (attributes `attrs`) with its regressor, for editing through IPCA
+/// coefficients: the basis and regressor `train-regressor --ipca` saved in `reg_dir`, else a
+/// basis fitted and a regressor trained here on `set` (its files written to `scratch`).
+#[allow(clippy::too_many_arguments)]
+pub fn ipca_editor(
+    reg_dir: &Path,
+    set: &Dataset,
+    attrs: &[Attributes],
+    k: usize,
+    epochs: Option<usize>,
+    scratch: &Path,
+    progress: &dyn Progress,
+    device: &Device,
+) -> anyhow::Result<(BaselineCodec, Regressor)> {
+    let saved_basis = reg_dir.join(IPCA_BASIS_FILE);
+    let basis = Arc::new(match saved_basis.exists() {
+        true => BaselineBasis::load(&saved_basis)?,
+        false => {
+            let refs: Vec<_> = set.tables.iter().collect();
+            BaselineBasis::fit("IPCA", MappingKind::LogRelative, &refs, k, progress)?
+        }
+    });
+    let ipca = basis.codec(k)?;
+    let owner = ipca_owner_id(&basis, k);
+    let regressor = match Regressor::load_for(reg_dir, TargetKind::Ipca, &owner, k, device) {
+        Ok(r) => r,
+        Err(_) => {
+            let targets = set
+                .tables
+                .iter()
+                .map(|t| ipca.encode(t))
+                .collect::<deepbrdf_eval::Result<Vec<_>>>()?;
+            let data = RegressorData {
+                label: set.label.clone(),
+                names: set.names.clone(),
+                attributes: attrs.iter().map(Attributes::to_array).collect(),
+                targets,
+            };
+            let config = train_regressor::config(epochs, 0);
+            let target = Target { kind: TargetKind::Ipca, owner_id: owner, k };
+            train_regressor::train_into(scratch, &data, &config, target, progress, device)?
+        }
+    };
+    Ok((ipca, regressor))
 }

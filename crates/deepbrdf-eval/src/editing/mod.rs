@@ -4,15 +4,22 @@
 //! requested change and leakage into the other attributes, uniformity of consecutive image
 //! differences, monotonicity of a sweep, physical plausibility of a decoded table; [`lobe`]: the
 //! specular lobe read off the table as a person sees it, its floor, peak, width and colour, a
-//! dark hole at its centre, and the bars an edit is held to). The regressor of eq. (7) that turns
-//! edited attributes into latent values is `deepbrdf_model::regressor`.
+//! dark hole at its centre, and the bars an edit is held to); edits through a representation
+//! and its regressor ([`space`]: eq. (7)'s regressor is `deepbrdf_model::regressor`), the
+//! analytic edit without any network ([`analytic`]), and edits scored against a known answer
+//! ([`known`]).
 //!
 //! [`Attributes`]: crate::attributes::Attributes
 
+pub mod analytic;
+pub mod known;
 pub mod lobe;
 pub mod measures;
 pub mod request;
+pub mod space;
 
+pub use analytic::analytic_edit;
+pub use known::{KnownEdit, KnownTally};
 pub use lobe::{
     compare, dark_hole, judge_edit, verdict, BarCount, EditLobe, Lobe, LobeBar, LobeComparison,
     LobeTally, LobeVerdict,
@@ -22,3 +29,4 @@ pub use measures::{
     EditOutcome, Plausibility,
 };
 pub use request::{ColourEdit, Edit, EditedAttribute, ScalarEdit};
+pub use space::{blend, blend_tables, EditMode, Edited, ModelCodec, Space, DEFAULT_MODE};

@@ -25,7 +25,7 @@ pub struct Args {
     #[command(flatten)]
     pub edit: EditArgs,
     /// paper: Y' = Phi(alpha'); residual: Y' = Y + Phi(alpha') - Phi(alpha) [default: residual].
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = editing::mode_parser())]
     pub mode: Option<EditMode>,
     /// Output MERL .binary file.
     #[arg(short, long, value_name = "FILE")]

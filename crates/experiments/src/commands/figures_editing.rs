@@ -19,24 +19,19 @@
 //!
 //! Writes `results.md` (the tables), `suite.csv` (every material and edit) and the figures.
 use super::interpolate::{self, Path3};
-use super::train_regressor::{self, IPCA_BASIS_FILE};
 use crate::data_args::DataArgs;
-use crate::editing::{self, ipca_owner_id, EditMode, EditorArg, ModelCodec, Space};
+use crate::editing::{self, EditMode, EditorArg, ModelCodec, Space};
 use anyhow::Context;
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::attributes::{Attributes, FitConfig};
-use deepbrdf_eval::baseline::{BaselineBasis, MappingKind};
 use deepbrdf_eval::editing::{
     edit_outcome, is_monotone, judge_edit, plausibility, ColourEdit, Edit, EditLobe, EditOutcome,
     Lobe, LobeBar, LobeTally, ScalarEdit,
 };
-use deepbrdf_eval::harness::Codec;
 use deepbrdf_eval::metrics::{ImageRelae, ImageRelaeConfig};
 use deepbrdf_eval::stats::{finite_mean, finite_median};
-use deepbrdf_model::regressor::{Regressor, RegressorData, Target, TargetKind};
 use std::fmt::Write as _;
 use std::path::PathBuf;
-use std::sync::Arc;
 use std::time::Instant;
 
 #[derive(Debug, clap::Args)]
@@ -167,47 +162,13 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let k = model.k();
     let set = args.data.load(progress)?;
     let fit = FitConfig::default();
-    progress.start(set.len() as u64, "attributes");
-    let mut attrs = Vec::new();
-    for (name, t) in set.names.iter().zip(&set.tables) {
-        attrs.push(editing::attributes_of(t, name, &fit)?);
-        progress.advance(1);
-    }
-    progress.finish();
-
+    let attrs = editing::attributes_of_all(&set, &fit, progress)?;
     // IPCA at the same k, with its regressor (saved by `train-regressor --ipca`, else trained
     // here on the same materials).
     let reg_dir = editing::regressor_dir(&model_dir, args.editor.regressor.as_deref());
-    let saved_basis = reg_dir.join(IPCA_BASIS_FILE);
-    let basis = Arc::new(match saved_basis.exists() {
-        true => BaselineBasis::load(&saved_basis)?,
-        false => {
-            let refs: Vec<_> = set.tables.iter().collect();
-            BaselineBasis::fit("IPCA", MappingKind::LogRelative, &refs, k, progress)?
-        }
-    });
-    let ipca = basis.codec(k)?;
-    let owner = ipca_owner_id(&basis, k);
-    let ipca_regressor = match Regressor::load_for(&reg_dir, TargetKind::Ipca, &owner, k, &device) {
-        Ok(r) => r,
-        Err(_) => {
-            let targets = set
-                .tables
-                .iter()
-                .map(|t| ipca.encode(t))
-                .collect::<deepbrdf_eval::Result<Vec<_>>>()?;
-            let data = RegressorData {
-                label: set.label.clone(),
-                names: set.names.clone(),
-                attributes: attrs.iter().map(Attributes::to_array).collect(),
-                targets,
-            };
-            let config = train_regressor::config(args.epochs, 0);
-            let target = Target { kind: TargetKind::Ipca, owner_id: owner, k };
-            let scratch = args.out.join("ipca-regressor");
-            train_regressor::train_into(&scratch, &data, &config, target, progress, &device)?
-        }
-    };
+    let scratch = args.out.join("ipca-regressor");
+    let (ipca, ipca_regressor) =
+        editing::ipca_editor(&reg_dir, &set, &attrs, k, args.epochs, &scratch, progress, &device)?;
     let deep_codec = ModelCodec(&model);
     let deep =
         Rep { name: "DeepBRDF", space: Space { codec: &deep_codec, regressor: &deep_regressor } };

@@ -83,6 +83,12 @@ impl From<anyhow::Error> for Failure {
     }
 }
 
+impl From<deepbrdf_eval::EvalError> for Failure {
+    fn from(e: deepbrdf_eval::EvalError) -> Self {
+        anyhow::Error::from(e).into()
+    }
+}
+
 fn internal(e: impl std::fmt::Display) -> Failure {
     Failure::Internal(e.to_string())
 }

@@ -217,11 +217,7 @@ impl EditRequest {
         };
         let mode = match self.mode.as_deref() {
             None => DEFAULT_MODE,
-            Some("paper") => EditMode::Paper,
-            Some("residual") => EditMode::Residual,
-            Some(other) => {
-                return Err(bad(format!("edit mode {other:?}: expected paper or residual")))
-            }
+            Some(name) => name.parse::<EditMode>().map_err(|e| bad(e.to_string()))?,
         };
         let edit = Edit {
             diffuse: self.diffuse.map(ColourEdit::Set),

@@ -1,0 +1,83 @@
+//! The analytic edit: the baseline an edit through a learned representation has to beat. It
+//! needs no network: the table minus its fitted analytic model (the Lambertian + GGX model of
+//! the 7 [`Attributes`], §5.1) plus the same model at the requested attributes,
+//!
+//! `T'(cell) = max(0, T(cell) - M_a(cell) + M_a'(cell))`,
+//!
+//! so that what the model explains is replaced and what it does not (the residual: a second
+//! lobe, a sheen, the measurement's own shape) is kept as it is. An identity edit returns the
+//! table unchanged; a table that is exactly the model at `a` becomes exactly the model at `a'`.
+//! Cells the table holds invalid stay invalid; values are clamped at 0 where the removed lobe
+//! was larger than the table (a fitted lobe wider or brighter than the measured one).
+
+use crate::attributes::Attributes;
+use crate::error::{EvalError, Result};
+use deepbrdf_data::merl::INVALID_VALUE;
+use deepbrdf_data::MerlTable;
+
+/// `table` edited from its fitted attributes `fitted` to `requested` (see the module's
+/// documentation).
+pub fn analytic_edit(
+    table: &MerlTable,
+    fitted: &Attributes,
+    requested: &Attributes,
+) -> Result<MerlTable> {
+    if fitted == requested {
+        return Ok(table.clone());
+    }
+    let (before, after) = (fitted.table(), requested.table());
+    let values: Vec<f32> = table
+        .values()
+        .iter()
+        .zip(before.values().iter().zip(after.values()))
+        .map(|(&t, (&m, &m_new))| match t < 0.0 || m < 0.0 || m_new < 0.0 {
+            true if t < 0.0 => INVALID_VALUE,
+            true => t,
+            false => (f64::from(t) - f64::from(m) + f64::from(m_new)).max(0.0) as f32,
+        })
+        .collect();
+    MerlTable::from_values(values)
+        .map_err(|e| EvalError::Invalid(format!("analytic edit: the edited table: {e}")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use deepbrdf_data::merl::{cell_index, CELLS};
+
+    fn attributes(roughness: f64) -> Attributes {
+        Attributes { diffuse: [0.3, 0.2, 0.1], specular: [0.05, 0.05, 0.05], roughness }
+    }
+
+    #[test]
+    fn a_model_table_becomes_the_edited_model() {
+        let (a, b) = (attributes(0.1), attributes(0.2));
+        let edited = analytic_edit(&a.table(), &a, &b).unwrap();
+        let answer = b.table();
+        for (x, y) in edited.values().iter().zip(answer.values()) {
+            assert!((x - y).abs() <= 1e-5 * y.abs().max(1.0), "{x} vs {y}");
+        }
+        assert_eq!(analytic_edit(&answer, &b, &b).unwrap().values(), answer.values());
+    }
+
+    #[test]
+    fn the_residual_is_kept_and_invalid_cells_stay_invalid() {
+        let (a, b) = (attributes(0.1), attributes(0.05));
+        let mut table = a.table();
+        // A constant residual the model does not explain, and one invalid cell.
+        table.values_mut().iter_mut().filter(|v| **v >= 0.0).for_each(|v| *v += 0.25);
+        let far = cell_index(0, 40, 0);
+        table.values_mut()[far] = INVALID_VALUE;
+        let edited = analytic_edit(&table, &a, &b).unwrap();
+        let answer = b.table();
+        assert_eq!(edited.values()[far], INVALID_VALUE);
+        for c in (0..3 * CELLS).step_by(7919).filter(|&c| c != far && answer.values()[c] >= 0.0) {
+            let (x, y) = (edited.values()[c], answer.values()[c] + 0.25);
+            assert!((x - y).abs() <= 1e-4 * y.max(1.0), "value {c}: {x} vs {y}");
+        }
+        // Removing a lobe brighter than the table clamps at 0 instead of going negative.
+        let dark = MerlTable::from_fn(|_, _, _| [0.0; 3]);
+        let clamped = analytic_edit(&dark, &attributes(0.1), &attributes(0.3)).unwrap();
+        assert!(clamped.values().iter().all(|&v| v >= 0.0 || v == INVALID_VALUE));
+    }
+}

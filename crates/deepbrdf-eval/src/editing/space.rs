@@ -1,0 +1,184 @@
+//! Edits and interpolations through a representation (Hu et al. 2020, §5.1): a [`Codec`] (a
+//! DeepBRDF model or an IPCA basis) and the regressor of eq. (7) trained for it. The paper's
+//! edit is `Y' = Phi(alpha')`; the residual edit `Y' = Y + Phi(alpha') - Phi(alpha)` keeps
+//! what the attributes do not explain; interpolation blends two latents (or, as the reference
+//! path, two tables).
+
+use crate::attributes::Attributes;
+use crate::editing::Edit;
+use crate::error::{EvalError, Result};
+use crate::harness::Codec;
+use deepbrdf_data::merl::INVALID_VALUE;
+use deepbrdf_data::MerlTable;
+use deepbrdf_model::regressor::Regressor;
+use deepbrdf_model::DeepBrdf;
+use std::fmt;
+use std::str::FromStr;
+
+/// Which edit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EditMode {
+    /// The paper's edit: the latent of the edited attributes, `Y' = Phi(alpha')`.
+    Paper,
+    /// Keeps what the attributes do not explain: `Y' = Y + Phi(alpha') - Phi(alpha)`.
+    Residual,
+}
+
+impl EditMode {
+    /// Both modes.
+    pub const ALL: [EditMode; 2] = [EditMode::Paper, EditMode::Residual];
+
+    /// The mode's name on the command line and in results.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Paper => "paper",
+            Self::Residual => "residual",
+        }
+    }
+}
+
+impl fmt::Display for EditMode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for EditMode {
+    type Err = EvalError;
+
+    fn from_str(s: &str) -> Result<Self> {
+        Self::ALL.into_iter().find(|m| m.name() == s.trim()).ok_or_else(|| {
+            EvalError::Invalid(format!("edit mode {s:?}: expected paper or residual"))
+        })
+    }
+}
+
+/// The default mode: the residual edit. It keeps an unedited material as it is, which the
+/// paper's edit does not (docs/editing.md has the measured comparison).
+pub const DEFAULT_MODE: EditMode = EditMode::Residual;
+
+/// A DeepBRDF model borrowed as a [`Codec`] (eq. (2) to encode, eq. (3) to decode), mapping
+/// each table as it comes (the harness' [`crate::deep::DeepCodec`] caches the mapping instead).
+pub struct ModelCodec<'a>(pub &'a DeepBrdf);
+
+impl Codec for ModelCodec<'_> {
+    fn name(&self) -> String {
+        format!("DeepBRDF-{}", self.0.k())
+    }
+
+    fn k(&self) -> usize {
+        self.0.k()
+    }
+
+    fn encode(&self, table: &MerlTable) -> Result<Vec<f32>> {
+        self.0.encode(table).map_err(|e| EvalError::method(self.name(), e))
+    }
+
+    fn decode(&self, code: &[f32]) -> Result<MerlTable> {
+        self.0.decode(code).map_err(|e| EvalError::method(self.name(), e))
+    }
+}
+
+/// A representation and its regressor.
+pub struct Space<'a> {
+    pub codec: &'a dyn Codec,
+    pub regressor: &'a Regressor,
+}
+
+/// An edit's result.
+pub struct Edited {
+    /// The attributes asked for.
+    pub requested: Attributes,
+    pub table: MerlTable,
+}
+
+impl Space<'_> {
+    /// Eq. (7): the latent of `a`.
+    pub fn latent_of(&self, a: &Attributes) -> Result<Vec<f32>> {
+        self.regressor
+            .predict(&a.to_array())
+            .map_err(|e| EvalError::method(format!("{} regressor", self.codec.name()), e))
+    }
+
+    /// Edits `table`, whose attributes are `original` (and latent `latent`, for the residual
+    /// edit), by `edit` in `mode`.
+    pub fn edit(
+        &self,
+        latent: &[f32],
+        original: &Attributes,
+        edit: &Edit,
+        mode: EditMode,
+    ) -> Result<Edited> {
+        let requested = edit.apply(original)?;
+        let latent = self.edited_latent(latent, original, &requested, mode)?;
+        let table = self.codec.decode(&latent)?;
+        Ok(Edited { requested, table })
+    }
+
+    /// The latent of the edit from `original` (latent `latent`, used by the residual edit) to
+    /// the attributes `requested` (checked by [`Edit::apply`]), before decoding.
+    pub fn edited_latent(
+        &self,
+        latent: &[f32],
+        original: &Attributes,
+        requested: &Attributes,
+        mode: EditMode,
+    ) -> Result<Vec<f32>> {
+        let target = self.latent_of(requested)?;
+        Ok(match mode {
+            EditMode::Paper => target,
+            EditMode::Residual => {
+                let base = self.latent_of(original)?;
+                latent.iter().zip(target.iter().zip(&base)).map(|(y, (t, b))| y + t - b).collect()
+            }
+        })
+    }
+}
+
+/// `(1 - t) a + t b`.
+pub fn blend(a: &[f32], b: &[f32], t: f64) -> Vec<f32> {
+    a.iter().zip(b).map(|(&x, &y)| ((1.0 - t) * f64::from(x) + t * f64::from(y)) as f32).collect()
+}
+
+/// The plain linear blend of two tables (the reference path of interpolation): valid cells of
+/// both blended, the others invalid.
+pub fn blend_tables(a: &MerlTable, b: &MerlTable, t: f64) -> Result<MerlTable> {
+    let values: Vec<f32> = a
+        .values()
+        .iter()
+        .zip(b.values())
+        .map(|(&x, &y)| match x < 0.0 || y < 0.0 {
+            true => INVALID_VALUE,
+            false => ((1.0 - t) * f64::from(x) + t * f64::from(y)) as f32,
+        })
+        .collect();
+    Ok(MerlTable::from_values(values)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use deepbrdf_data::testing::synthetic_table;
+
+    #[test]
+    fn modes_parse_by_name() {
+        for m in EditMode::ALL {
+            assert_eq!(m.name().parse::<EditMode>().unwrap(), m);
+        }
+        assert!("linear".parse::<EditMode>().unwrap_err().to_string().contains("paper"));
+    }
+
+    #[test]
+    fn blends_are_linear_and_keep_invalid_cells() {
+        assert_eq!(blend(&[0.0, 2.0], &[1.0, 4.0], 0.25), vec![0.25, 2.5]);
+        let (a, mut b) = (synthetic_table(1), synthetic_table(2));
+        let cell = a.values().iter().position(|&v| v >= 0.0).unwrap();
+        b.values_mut()[cell] = INVALID_VALUE;
+        let mid = blend_tables(&a, &b, 0.5).unwrap();
+        assert_eq!(mid.values()[cell], INVALID_VALUE);
+        assert_eq!(blend_tables(&a, &b, 0.0).unwrap().values()[cell + 1], a.values()[cell + 1]);
+        let (x, y) = (a.values()[cell + 1], b.values()[cell + 1]);
+        let m = mid.values()[cell + 1];
+        assert!((f64::from(m) - 0.5 * (f64::from(x) + f64::from(y))).abs() < 1e-6);
+    }
+}
