@@ -93,11 +93,22 @@ pub fn create_parent_and_write(path: &Path, bytes: &[u8]) -> Result<()> {
     write_atomic(path, bytes)
 }
 
-/// Writes `parts`, concatenated, to `path` atomically (the one atomic writer of the workspace):
-/// a uniquely named temporary file in the same directory (two runs writing the same path never
-/// share it) is written, flushed to disk (fsync) and renamed over `path`, then the directory entry
-/// is flushed. On failure `path` is untouched and the temporary file is removed.
+/// Writes `parts`, concatenated, to `path` atomically ([`write_atomic_with`]).
 pub fn write_atomic_parts(path: &Path, parts: &[&[u8]]) -> Result<()> {
+    write_atomic_with(path, |out, tmp| {
+        parts.iter().try_for_each(|part| out.write_all(part).map_err(|e| DataError::io(tmp, e)))
+    })
+}
+
+/// Writes to `path` atomically what `write(out, temporary_path)` writes to `out` (the one atomic
+/// writer of the workspace; a long output is streamed through a buffer, never held whole): a
+/// uniquely named temporary file in the same directory (two runs writing the same path never
+/// share it) is written, flushed to disk (fsync) and renamed over `path`, then the directory entry
+/// is flushed. On failure (of `write` too) `path` is untouched and the temporary file is removed.
+pub fn write_atomic_with(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write, &Path) -> Result<()>,
+) -> Result<()> {
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -109,11 +120,12 @@ pub fn write_atomic_parts(path: &Path, parts: &[&[u8]]) -> Result<()> {
     builder.prefix(TEMP_PREFIX).suffix(TEMP_SUFFIX);
     #[cfg(unix)]
     builder.permissions(mode_for(path));
-    let mut tmp = builder.tempfile_in(dir).map_err(|e| DataError::io(dir, e))?;
-    for part in parts {
-        tmp.write_all(part).map_err(|e| DataError::io(tmp.path(), e))?;
-    }
-    tmp.as_file().sync_all().map_err(|e| DataError::io(tmp.path(), e))?;
+    let tmp = builder.tempfile_in(dir).map_err(|e| DataError::io(dir, e))?;
+    let tmp_path = tmp.path().to_path_buf();
+    let mut out = std::io::BufWriter::new(tmp);
+    write(&mut out, &tmp_path)?;
+    let tmp = out.into_inner().map_err(|e| DataError::io(&tmp_path, e.into_error()))?;
+    tmp.as_file().sync_all().map_err(|e| DataError::io(&tmp_path, e))?;
     tmp.persist(path).map_err(|e| DataError::io(path, e.error))?;
     sync_dir_of(path);
     Ok(())

@@ -5,7 +5,8 @@
 //! `f = diffuse / pi + D(h) G1(wi) G1(wo) F(wi . h) / (4 cos_i cos_o)`.
 //!
 //! The renderer's GGX lobe (`deepbrdf-render`) evaluates it through [`ggx`]; tests tabulate it
-//! on the MERL grid ([`crate::testing::tabulate`]).
+//! on the MERL grid ([`crate::corpus::tabulate`]), and the corpus' microfacet lobes
+//! ([`crate::corpus::microfacet`]) use its distribution, masking and Fresnel terms.
 
 use std::f64::consts::PI;
 
@@ -52,12 +53,16 @@ pub fn ggx(lobe: &Ggx, wi: [f64; 3], wo: [f64; 3]) -> [f64; 3] {
     let h = [s[0] * inv, s[1] * inv, s[2] * inv];
     let d = distribution(lobe.alpha, h[2]);
     let g = smith_g1(lobe.alpha, ci) * smith_g1(lobe.alpha, co);
-    let cd = (wi[0] * h[0] + wi[1] * h[1] + wi[2] * h[2]).clamp(0.0, 1.0);
-    let schlick = (1.0 - cd).powi(5);
+    let cd = wi[0] * h[0] + wi[1] * h[1] + wi[2] * h[2];
     let common = d * g / (4.0 * ci * co);
-    std::array::from_fn(|c| {
-        lobe.diffuse[c] / PI + (lobe.f0[c] + (1.0 - lobe.f0[c]) * schlick) * common
-    })
+    std::array::from_fn(|c| lobe.diffuse[c] / PI + schlick(lobe.f0[c], cd) * common)
+}
+
+/// Schlick's 1994 approximation of the Fresnel reflectance at `cos_d = wi . h` (clamped to
+/// [0, 1]): `F = f0 + (1 - f0) (1 - cos_d)^5`.
+#[inline]
+pub fn schlick(f0: f64, cos_d: f64) -> f64 {
+    f0 + (1.0 - f0) * (1.0 - cos_d.clamp(0.0, 1.0)).powi(5)
 }
 
 #[cfg(test)]
@@ -88,15 +93,8 @@ mod tests {
 
     #[test]
     fn distribution_is_normalised() {
-        // integral over the hemisphere of D(h) cos(theta_h) = 1 (midpoint rule in theta).
         for alpha in [0.05, 0.3, 0.8] {
-            let n = 200_000;
-            let mut sum = 0.0;
-            for i in 0..n {
-                let t = (i as f64 + 0.5) / n as f64 * PI / 2.0;
-                sum += distribution(alpha, t.cos()) * t.cos() * t.sin();
-            }
-            let integral = sum * 2.0 * PI * (PI / 2.0) / n as f64;
+            let integral = crate::corpus::checks::projected_integral(|c| distribution(alpha, c));
             assert!((integral - 1.0).abs() < 1e-3, "alpha {alpha}: {integral}");
         }
     }

@@ -2,6 +2,7 @@
 pub mod augment;
 pub mod bundled;
 pub mod cache;
+pub mod corpus;
 pub mod dataset;
 pub mod error;
 pub mod fetch;
