@@ -88,6 +88,9 @@ pub enum Command {
     FiguresGeneralize(commands::figures_generalize::Args),
     /// The editing figures (Figs. 10, 12, 13, 14) and the measured edit suite.
     FiguresEditing(commands::figures_editing::Args),
+    /// Edits against known answers: analytic corpus materials edited by the analytic edit,
+    /// DeepBRDF and IPCA, each scored by its distance to the material with the parameter changed.
+    EditKnown(commands::edit_known::Args),
     /// The browser material editor: sliders for the 7 attributes and a blend, a live preview,
     /// downloads of the edited .binary and latent (http://127.0.0.1:7878/ by default).
     Serve(commands::serve::Args),

@@ -2,6 +2,7 @@
 mod broken_pipe;
 mod cli;
 mod commands;
+mod corpus_arg;
 mod data_args;
 mod device_arg;
 mod editing;

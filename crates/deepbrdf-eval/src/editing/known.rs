@@ -28,6 +28,9 @@ pub struct KnownEdit {
     pub unedited: f64,
     /// Image RelAE of the edited table against the answer.
     pub edited: f64,
+    /// Whether the edit left a dark hole at the highlight that the original did not have
+    /// ([`super::lobe::dark_hole`]); `None` where the lobe could not be read.
+    pub dark_hole: Option<bool>,
 }
 
 impl KnownEdit {
@@ -77,6 +80,8 @@ pub struct KnownTally {
     pub farther: usize,
     /// Median of [`KnownEdit::ratio`] (NaN for no edit).
     pub median_ratio: f64,
+    /// Edits that left a dark hole.
+    pub dark_holes: usize,
 }
 
 impl KnownTally {
@@ -89,12 +94,13 @@ impl KnownTally {
             halved: rows.iter().filter(|r| r.halves()).count(),
             farther: rows.iter().filter(|r| r.farther()).count(),
             median_ratio: finite_median(ratios),
+            dark_holes: rows.iter().filter(|r| r.dark_hole == Some(true)).count(),
         }
     }
 }
 
 /// The summary table: one row per method and edit (in first-seen order), then one per method
-/// over all its edits: edits, halved, farther, median ratio.
+/// over all its edits: edits, halved, farther, median ratio, dark holes.
 pub fn markdown(rows: &[KnownEdit]) -> String {
     let mut methods: Vec<&str> = Vec::new();
     let mut edits: Vec<&str> = Vec::new();
@@ -107,14 +113,14 @@ pub fn markdown(rows: &[KnownEdit]) -> String {
         }
     }
     let mut md = String::from(
-        "| method | edit | edits | at most half as far | farther than unedited | median ratio |\n\
-         | --- | --- | ---: | ---: | ---: | ---: |\n",
+        "| method | edit | edits | at most half as far | farther than unedited | median ratio | dark holes |\n\
+         | --- | --- | ---: | ---: | ---: | ---: | ---: |\n",
     );
     let mut line = |method: &str, edit: &str, t: KnownTally| {
         let _ = writeln!(
             md,
-            "| {method} | {edit} | {} | {} | {} | {:.3} |",
-            t.edits, t.halved, t.farther, t.median_ratio
+            "| {method} | {edit} | {} | {} | {} | {:.3} | {} |",
+            t.edits, t.halved, t.farther, t.median_ratio, t.dark_holes
         );
     };
     for &method in &methods {
@@ -129,14 +135,21 @@ pub fn markdown(rows: &[KnownEdit]) -> String {
     md
 }
 
-/// The rows as CSV (material, edit, method, unedited, edited, ratio, halves, farther).
+/// The rows as CSV (material, edit, method, unedited, edited, ratio, halves, farther, dark
+/// hole: yes, no, or empty where not measured).
 pub fn csv(rows: &[KnownEdit]) -> String {
-    let mut out =
-        String::from("material,edit,method,unedited_relae,edited_relae,ratio,halves,farther\n");
+    let mut out = String::from(
+        "material,edit,method,unedited_relae,edited_relae,ratio,halves,farther,dark_hole\n",
+    );
     for r in rows {
+        let hole = match r.dark_hole {
+            Some(true) => "yes",
+            Some(false) => "no",
+            None => "",
+        };
         let _ = writeln!(
             out,
-            "{},{},{},{:.6},{:.6},{:.6},{},{}",
+            "{},{},{},{:.6},{:.6},{:.6},{},{},{hole}",
             r.material,
             r.edit,
             r.method,
@@ -163,6 +176,7 @@ mod tests {
             method: method.into(),
             unedited,
             edited,
+            dark_hole: Some(edited > unedited),
         }
     }
 
@@ -179,10 +193,13 @@ mod tests {
         assert!((t.median_ratio - 0.75).abs() < 1e-12);
         assert!(rows[3].farther() && !rows[3].halves());
         let md = markdown(&rows);
+        assert_eq!(t.dark_holes, 1);
         assert!(md.contains("| a | x2 | 2 | 1 | 1 |"), "{md}");
-        assert!(md.contains("| a | **all** | 3 | 1 | 1 | 0.750 |"), "{md}");
+        assert!(md.contains("| a | **all** | 3 | 1 | 1 | 0.750 | 1 |"), "{md}");
         assert!(md.contains("| b | x2 | 1 | 0 | 1 |"), "{md}");
-        assert_eq!(csv(&rows).lines().count(), 5);
+        let csv = csv(&rows);
+        assert_eq!(csv.lines().count(), 5);
+        assert!(csv.lines().nth(2).unwrap().ends_with(",true,yes"), "{csv}");
     }
 
     #[test]

@@ -10,6 +10,7 @@ pub mod convert;
 pub mod decode;
 pub mod devices;
 pub mod edit;
+pub mod edit_known;
 pub mod encode;
 pub mod fetch_merl;
 pub mod figures_editing;
@@ -58,6 +59,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Edit(args) => edit::run(args, &progress),
         Command::Interpolate(args) => interpolate::run(args, &progress),
         Command::FiguresEditing(args) => figures_editing::run(args, &progress),
+        Command::EditKnown(args) => edit_known::run(args, &progress),
         Command::FiguresGeneralize(args) => figures_generalize::run(args, &progress),
         Command::RenderSet(args) => render_set::run(args, &progress),
         Command::TrainRecovery(args) => train_recovery::run(args, &progress),

@@ -66,6 +66,8 @@ pub struct Args {
     /// shipped default model.
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     pub add_collections: Vec<Collection>,
+    #[command(flatten)]
+    pub corpus: crate::corpus_arg::CorpusArg,
 }
 
 fn parse_preset(s: &str) -> Result<Preset, String> {
@@ -154,6 +156,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         data.names.extend(more.names);
         data.tables.extend(more.tables);
     }
+    args.corpus.add_to(&mut data, progress)?;
     eprintln!(
         "training DeepBRDF k = {} on {} ({} BRDFs), {} epochs of batches of {}, on {kind}",
         config.model.latent,

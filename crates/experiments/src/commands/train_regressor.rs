@@ -46,6 +46,8 @@ pub struct Args {
     pub force: bool,
     #[command(flatten)]
     pub data: DataArgs,
+    #[command(flatten)]
+    pub corpus: crate::corpus_arg::CorpusArg,
 }
 
 /// The regressor's settings for these arguments.
@@ -108,7 +110,8 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let device = crate::device_arg::device()?;
     let model = DeepBrdf::load(&model_dir, &device)
         .with_context(|| format!("loading the model {}", model_dir.display()))?;
-    let set = args.data.load(progress)?;
+    let mut set = args.data.load(progress)?;
+    args.corpus.add_to(&mut set, progress)?;
     let fit = FitConfig::default();
     progress.start(set.len() as u64, "attributes and latents");
     let mut attributes = Vec::with_capacity(set.len());
