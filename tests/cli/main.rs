@@ -4,6 +4,7 @@ mod util;
 mod attributes;
 mod baselines;
 mod convert;
+mod corpus;
 mod data;
 mod devices;
 mod editing;

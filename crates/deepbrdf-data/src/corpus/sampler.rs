@@ -53,7 +53,7 @@ fn draw(family: Family, rng: &mut ChaCha8Rng) -> Material {
         Material { family, diffuse: None, lobes: vec![], sheen: None, retro: None, coat: None };
     match family {
         Family::Plastic => {
-            m.diffuse = Some(diffuse_base(rng, (0.0, 0.5), (0.02, 0.9)));
+            m.diffuse = Some(diffuse_base(rng, (0.0, 0.9), (0.02, 0.9)));
             let alpha = roughness(rng);
             m.lobes.push(dielectric_lobe(rng, alpha, 1.0));
         }

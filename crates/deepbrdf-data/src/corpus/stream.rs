@@ -15,7 +15,8 @@ pub fn sampled(seed: u64, range: Range<u64>) -> impl Iterator<Item = Result<Reco
 
 /// Tabulates each record of `records` and calls `each(record, table)` in order; `batch`
 /// materials (at least 1) are tabulated at a time, in parallel. Stops at the first error (of a
-/// record, a tabulation or `each`). Returns the number of materials tabulated.
+/// record, a tabulation or `each`). Advances `progress` by one a material (the caller starts and
+/// finishes it). Returns the number of materials tabulated.
 pub fn tabulate_each(
     records: impl Iterator<Item = Result<Record>>,
     batch: usize,

@@ -7,6 +7,7 @@ pub mod baselines;
 pub mod bench;
 pub mod compare;
 pub mod convert;
+pub mod corpus;
 pub mod decode;
 pub mod devices;
 pub mod edit;
@@ -43,6 +44,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Folds(args) => folds::run(args, &progress),
         Command::Tabulate(args) => tabulate::run(args, &progress),
         Command::PackNbrdf(args) => pack_nbrdf::run(args, &progress),
+        Command::Corpus(args) => corpus::run(args, &progress),
         Command::Train(args) => train::run(args, &progress),
         Command::Encode(args) => encode::run(args, &progress),
         Command::Decode(args) => decode::run(args, &progress),
