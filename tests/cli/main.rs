@@ -7,6 +7,7 @@ mod convert;
 mod corpus;
 mod data;
 mod devices;
+mod edit_known;
 mod editing;
 mod fetch_merl;
 mod generalize;

@@ -44,9 +44,9 @@ impl CorpusArg {
         })
         .with_context(|| format!("reading the corpus {}", path.display()))?;
         progress.finish();
-        let file = path.file_name().map_or_else(|| path.display().to_string(), |f| {
-            f.to_string_lossy().into_owned()
-        });
+        let file = path
+            .file_name()
+            .map_or_else(|| path.display().to_string(), |f| f.to_string_lossy().into_owned());
         data.label = format!("{}+corpus({count} of {file})", data.label);
         Ok(count)
     }

@@ -1,0 +1,91 @@
+//! `train --corpus`, `train-regressor --corpus` and `edit-known` end to end with a tiny model on
+//! three synthetic materials and a few corpus materials: the corpus materials join the training
+//! set, and every known-answer edit is scored for each of the four methods, the analytic edit
+//! ending nearer the answer than the unedited material.
+use crate::util::{self, s};
+
+#[test]
+fn corpus_training_and_known_answer_edits() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = util::write_data(dir.path(), 3);
+    let ok = |args: &[&str]| {
+        let out = util::run_in(dir.path(), args);
+        assert!(out.status.success(), "{args:?}: {}", util::stderr(&out));
+        (util::stdout(&out), util::stderr(&out))
+    };
+    let corpus = dir.path().join("corpus");
+    ok(&["corpus", "--count", "40", "--seed", "5", "--out", &s(&corpus)]);
+    let file = s(&corpus.join("corpus.jsonl"));
+    let config = util::tiny_config(dir.path());
+    let run = dir.path().join("run");
+    let (_, err) = ok(&[
+        "train",
+        "--config",
+        &s(&config),
+        "--data",
+        &s(&data),
+        "--corpus",
+        &file,
+        "--corpus-count",
+        "2",
+        "--out",
+        &s(&run),
+    ]);
+    assert!(err.contains("(5 BRDFs)") && err.contains("corpus(2 of corpus.jsonl)"), "{err}");
+    let model = s(&run);
+    ok(&[
+        "train-regressor",
+        "--model",
+        &model,
+        "--data",
+        &s(&data),
+        "--corpus",
+        &file,
+        "--corpus-count",
+        "2",
+        "--epochs",
+        "20",
+        "--ipca",
+    ]);
+    let out = dir.path().join("known");
+    let (printed, _) = ok(&[
+        "edit-known",
+        "--model",
+        &model,
+        "--data",
+        &s(&data),
+        "--count",
+        "2",
+        "--seed",
+        "7",
+        "--out",
+        &s(&out),
+    ]);
+    assert!(printed.contains("| analytic | **all** |"), "{printed}");
+    let csv = std::fs::read_to_string(out.join("known.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    assert!(!rows.is_empty() && rows.len() % 4 == 0, "{csv}");
+    for method in ["analytic", "DeepBRDF residual", "DeepBRDF paper", "IPCA residual"] {
+        assert_eq!(rows.iter().filter(|r| r[2] == method).count(), rows.len() / 4, "{csv}");
+    }
+    // The analytic edit of an analytic material moves towards the answer.
+    assert!(rows.iter().filter(|r| r[2] == "analytic").all(|r| r[7] == "false"), "{csv}");
+    assert!(std::fs::read_to_string(out.join("results.md")).unwrap().contains("--seed 7"));
+    // A missing corpus file is a clean error naming it.
+    let missing = s(&dir.path().join("none.jsonl"));
+    let o = util::run_in(
+        dir.path(),
+        &[
+            "train",
+            "--config",
+            &s(&config),
+            "--data",
+            &s(&data),
+            "--corpus",
+            &missing,
+            "--out",
+            "x",
+        ],
+    );
+    util::assert_clean_failure(&o, "none.jsonl");
+}
