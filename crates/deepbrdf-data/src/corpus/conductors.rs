@@ -125,7 +125,7 @@ mod tests {
         assert_eq!(gold.name, "gold");
         assert!(gold.f0[0] > gold.f0[2]);
         assert_eq!(conductor("silver").expect("by name").symbol, "Ag");
-        assert!(conductor("Xx").unwrap_err().to_string().contains("Au"));
+        assert!(conductor("Xx").expect_err("unknown").to_string().contains("Au"));
     }
 
     #[test]

@@ -245,13 +245,17 @@ mod tests {
         assert!(json.contains("\"coated-paint\"") && json.contains("\"beckmann\""), "{json}");
         let mut bad = m.clone();
         bad.lobes[0].alpha = 0.0;
-        assert!(bad.validate().unwrap_err().to_string().contains("lobes[0].alpha = 0"));
+        assert!(bad.validate().expect_err("invalid").to_string().contains("lobes[0].alpha = 0"));
         let mut bad = m.clone();
         bad.diffuse = Some(Diffuse::OrenNayar { albedo: [0.5, f64::NAN, 0.5], sigma: 0.1 });
-        assert!(bad.validate().unwrap_err().to_string().contains("diffuse.albedo[1] = NaN"));
+        assert!(bad
+            .validate()
+            .expect_err("invalid")
+            .to_string()
+            .contains("diffuse.albedo[1] = NaN"));
         let mut bad = m.clone();
         bad.lobes = vec![m.lobes[0]; 3];
-        assert!(bad.validate().unwrap_err().to_string().contains("3 lobes"));
+        assert!(bad.validate().expect_err("invalid").to_string().contains("3 lobes"));
         let empty = Material {
             family: Family::Plastic,
             diffuse: None,

@@ -32,11 +32,10 @@ pub fn sample(seed: u64, index: u64) -> Material {
     draw(family, &mut rng)
 }
 
-/// Material `index` of `seed` drawn from `family` (a family's own sequence: the same (seed,
-/// index) gives another material than [`sample`]).
+/// Material `index` of `seed` drawn from `family` (for figures and tests of one family): the
+/// generator of [`sample`], with the number `sample` spends on the family skipped.
 pub fn sample_family(family: Family, seed: u64, index: u64) -> Material {
     let mut rng = generator(seed, index);
-    // Decorrelated from `sample`'s draw of the family.
     let _: u32 = rng.random();
     draw(family, &mut rng)
 }
