@@ -1,14 +1,17 @@
 //! The analytic edit: the baseline an edit through a learned representation has to beat. It
-//! needs no network: the table minus its fitted analytic model (the Lambertian + GGX model of
-//! the 7 [`Attributes`], §5.1) plus the same model at the requested attributes,
+//! needs no network: the table's fitted analytic model (the Lambertian + GGX model of the 7
+//! [`Attributes`], §5.1) is replaced by the same model at the requested attributes, and what
+//! the model does not explain (a second lobe, a sheen, the measurement's own shape) is kept:
 //!
-//! `T'(cell) = max(0, T(cell) - M_a(cell) + M_a'(cell))`,
+//! `T' = T - M_a + M_a'` where the table is above its model (`T >= M_a`: an additive residual),
+//! `T' = M_a' T / M_a` where it is below (a fitted lobe brighter or wider than the measured one:
+//! the new model scaled by the same shortfall).
 //!
-//! so that what the model explains is replaced and what it does not (the residual: a second
-//! lobe, a sheen, the measurement's own shape) is kept as it is. An identity edit returns the
-//! table unchanged; a table that is exactly the model at `a` becomes exactly the model at `a'`.
-//! Cells the table holds invalid stay invalid; values are clamped at 0 where the removed lobe
-//! was larger than the table (a fitted lobe wider or brighter than the measured one).
+//! The two agree at `T = M_a`, and `T'` is never negative: subtracting an overshooting lobe
+//! and clamping at 0 leaves a dark hole at the highlight once the new lobe is wider (roughness
+//! up), which the scaled branch does not. An identity edit returns the table unchanged; a table
+//! that is exactly the model at `a` becomes exactly the model at `a'`. Cells the table holds
+//! invalid stay invalid.
 
 use crate::attributes::Attributes;
 use crate::error::{EvalError, Result};
@@ -33,11 +36,19 @@ pub fn analytic_edit(
         .map(|(&t, (&m, &m_new))| match t < 0.0 || m < 0.0 || m_new < 0.0 {
             true if t < 0.0 => INVALID_VALUE,
             true => t,
-            false => (f64::from(t) - f64::from(m) + f64::from(m_new)).max(0.0) as f32,
+            false => edit_value(f64::from(t), f64::from(m), f64::from(m_new)) as f32,
         })
         .collect();
     MerlTable::from_values(values)
         .map_err(|e| EvalError::Invalid(format!("analytic edit: the edited table: {e}")))
+}
+
+/// One value of the edit: table `t`, model `m` before and `m_new` after (all >= 0).
+fn edit_value(t: f64, m: f64, m_new: f64) -> f64 {
+    match t >= m {
+        true => t - m + m_new,
+        false => m_new * t / m,
+    }
 }
 
 #[cfg(test)]
@@ -75,9 +86,15 @@ mod tests {
             let (x, y) = (edited.values()[c], answer.values()[c] + 0.25);
             assert!((x - y).abs() <= 1e-4 * y.max(1.0), "value {c}: {x} vs {y}");
         }
-        // Removing a lobe brighter than the table clamps at 0 instead of going negative.
+        // Below its model the table's shortfall scales the new model: never negative, and a
+        // black table stays black.
         let dark = MerlTable::from_fn(|_, _, _| [0.0; 3]);
-        let clamped = analytic_edit(&dark, &attributes(0.1), &attributes(0.3)).unwrap();
-        assert!(clamped.values().iter().all(|&v| v >= 0.0 || v == INVALID_VALUE));
+        let edited = analytic_edit(&dark, &attributes(0.1), &attributes(0.3)).unwrap();
+        assert!(edited.values().iter().all(|&v| v == 0.0 || v == INVALID_VALUE));
+        assert_eq!(edit_value(1.0, 4.0, 2.0), 0.5);
+        assert_eq!(edit_value(5.0, 4.0, 2.0), 3.0);
+        // The branches meet at t = m.
+        assert_eq!(edit_value(4.0, 4.0, 2.0), 2.0);
+        assert!((edit_value(4.0 - 1e-9, 4.0, 2.0) - 2.0).abs() < 1e-8);
     }
 }

@@ -37,12 +37,45 @@ pub struct Args {
     /// Output folder.
     #[arg(long, value_name = "DIR", default_value = "runs/edit-known")]
     pub out: PathBuf,
+    /// The methods that edit (comma-separated).
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        default_value = "analytic,deepbrdf-residual,deepbrdf-paper,ipca-residual"
+    )]
+    pub methods: Vec<Method>,
     /// Epochs of the IPCA regressor when none is saved [default: the library's].
     #[arg(long)]
     pub epochs: Option<usize>,
     /// The materials IPCA is fitted to (and its regressor trained on, when none is saved).
     #[command(flatten)]
     pub data: DataArgs,
+}
+
+/// A method that edits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Method {
+    /// The analytic edit, no network (`deepbrdf_eval::editing::analytic`).
+    Analytic,
+    /// DeepBRDF's residual edit.
+    DeepbrdfResidual,
+    /// DeepBRDF's edit of the paper.
+    DeepbrdfPaper,
+    /// IPCA's residual edit.
+    IpcaResidual,
+}
+
+impl Method {
+    /// The method's name in the results.
+    fn label(self) -> &'static str {
+        match self {
+            Self::Analytic => "analytic",
+            Self::DeepbrdfResidual => "DeepBRDF residual",
+            Self::DeepbrdfPaper => "DeepBRDF paper",
+            Self::IpcaResidual => "IPCA residual",
+        }
+    }
 }
 
 /// One edit of the suite: its name, the edit asked of the fitted attributes, and the answer.
@@ -111,17 +144,29 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let k = model.k();
     let fit = FitConfig::default();
 
-    // IPCA at the model's k on the training materials, with its regressor.
-    let set = args.data.load(progress)?;
-    let attrs = editing::attributes_of_all(&set, &fit, progress)?;
-    let reg_dir = editing::regressor_dir(&model_dir, args.editor.regressor.as_deref());
-    let scratch = args.out.join("ipca-regressor");
-    let (ipca, ipca_regressor) =
-        editing::ipca_editor(&reg_dir, &set, &attrs, k, args.epochs, &scratch, progress, &device)?;
-    drop(set);
+    // IPCA at the model's k on the training materials, with its regressor, when asked for.
+    let ipca = match args.methods.contains(&Method::IpcaResidual) {
+        true => {
+            let set = args.data.load(progress)?;
+            let attrs = editing::attributes_of_all(&set, &fit, progress)?;
+            let reg_dir = editing::regressor_dir(&model_dir, args.editor.regressor.as_deref());
+            let scratch = args.out.join("ipca-regressor");
+            Some(editing::ipca_editor(
+                &reg_dir,
+                &set,
+                &attrs,
+                k,
+                args.epochs,
+                &scratch,
+                progress,
+                &device,
+            )?)
+        }
+        false => None,
+    };
     let deep_codec = ModelCodec(&model);
     let deep = Space { codec: &deep_codec, regressor: &deep_regressor };
-    let ipca_space = Space { codec: &ipca, regressor: &ipca_regressor };
+    let ipca_space = ipca.as_ref().map(|(codec, regressor)| Space { codec, regressor });
 
     let config = ImageRelaeConfig::default();
     let mut rows: Vec<KnownEdit> = Vec::new();
@@ -133,7 +178,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         let table = material.table().with_context(|| format!("tabulating {name}"))?;
         let fitted = editing::attributes_of(&table, &name, &fit)?;
         let deep_latent = deep.codec.encode(&table)?;
-        let ipca_latent = ipca_space.codec.encode(&table)?;
+        let ipca_latent = ipca_space.as_ref().map(|s| s.codec.encode(&table)).transpose()?;
         let lobe = Lobe::of(&table).ok();
         for case in cases(&material, &fitted) {
             let Ok(requested) = case.edit.apply(&fitted) else {
@@ -146,18 +191,26 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             }
             let answer =
                 case.answer.table().with_context(|| format!("tabulating {name} {}", case.name))?;
-            let candidates: Vec<(&str, MerlTable)> = vec![
-                ("analytic", analytic_edit(&table, &fitted, &requested)?),
-                ("DeepBRDF residual", {
-                    deep.edit(&deep_latent, &fitted, &case.edit, EditMode::Residual)?.table
-                }),
-                ("DeepBRDF paper", {
-                    deep.edit(&deep_latent, &fitted, &case.edit, EditMode::Paper)?.table
-                }),
-                ("IPCA residual", {
-                    ipca_space.edit(&ipca_latent, &fitted, &case.edit, EditMode::Residual)?.table
-                }),
-            ];
+            let edit_by = |method: Method| -> anyhow::Result<MerlTable> {
+                let deep_edit = |mode| deep.edit(&deep_latent, &fitted, &case.edit, mode);
+                Ok(match method {
+                    Method::Analytic => analytic_edit(&table, &fitted, &requested)?,
+                    Method::DeepbrdfResidual => deep_edit(EditMode::Residual)?.table,
+                    Method::DeepbrdfPaper => deep_edit(EditMode::Paper)?.table,
+                    Method::IpcaResidual => {
+                        let (space, latent) = ipca_space
+                            .as_ref()
+                            .zip(ipca_latent.as_ref())
+                            .context("IPCA was not loaded")?;
+                        space.edit(latent, &fitted, &case.edit, EditMode::Residual)?.table
+                    }
+                })
+            };
+            let candidates = args
+                .methods
+                .iter()
+                .map(|&m| Ok((m.label(), edit_by(m)?)))
+                .collect::<anyhow::Result<Vec<(&str, MerlTable)>>>()?;
             let tables: Vec<&MerlTable> = candidates.iter().map(|(_, t)| t).collect();
             let (unedited, edited) = known::distances(&answer, &table, &tables, &config)
                 .with_context(|| format!("{name}, {}", case.name))?;
@@ -180,7 +233,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let summary = known::markdown(&rows);
     let md = format!(
         "# Edits against known answers\n\nWritten by `experiments edit-known --count {} --seed {}` \
-         (model {}, k = {k}; IPCA at k = {k} fitted to {}; {} analytic corpus materials, none of \
+         (model {}, k = {k}; IPCA, where run, at k = {k} fitted to {}; {} analytic corpus materials, none of \
          them seen by any network; {} edits skipped where the answer is not the edit asked: an \
          albedo the material lacks, a roughness clamped). Distance: image RelAE against the \
          answer's render (128 px sphere, sun and sky, 16 spp); ratio = edited / unedited \
@@ -199,7 +252,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     println!("{summary}");
     println!(
         "{} edits of {} materials ({skipped} skipped) in {:.0} s -> {}",
-        rows.len() / 4,
+        rows.len() / args.methods.len().max(1),
         args.count,
         started.elapsed().as_secs_f64(),
         args.out.display()
