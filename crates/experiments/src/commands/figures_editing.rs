@@ -9,7 +9,8 @@
 //! - Fig. 14: the same sweep of specular-yellow-phenolic, DeepBRDF vs IPCA.
 //! - The suite, on every N-th material: diffuse albedo x0.5 and a hue change (its channels
 //!   rotated), specular albedo x0.5, roughness x0.5 and x2, and the identity edit, for DeepBRDF
-//!   and IPCA (at the model's k), paper and residual edits: the attributes re-estimated on each
+//!   and IPCA (at the model's k), paper and residual edits, and the analytic edit without a
+//!   network (`deepbrdf_eval::editing::analytic`): the attributes re-estimated on each
 //!   decoded table against the requested ones (target error, change ratio, drift of the
 //!   untouched attributes), the identity edit's image RelAE against the original, the
 //!   plausibility of every decoded table; the specular lobe read off each decoded table against
@@ -25,8 +26,8 @@ use anyhow::Context;
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::attributes::{Attributes, FitConfig};
 use deepbrdf_eval::editing::{
-    edit_outcome, is_monotone, judge_edit, plausibility, ColourEdit, Edit, EditLobe, EditOutcome,
-    Lobe, LobeBar, LobeTally, ScalarEdit,
+    analytic_edit, edit_outcome, is_monotone, judge_edit, plausibility, ColourEdit, Edit, EditLobe,
+    EditOutcome, Lobe, LobeBar, LobeTally, ScalarEdit,
 };
 use deepbrdf_eval::metrics::{ImageRelae, ImageRelaeConfig};
 use deepbrdf_eval::stats::{finite_mean, finite_median};
@@ -77,7 +78,8 @@ const SWEEP: [f64; 7] = [0.25, 0.397, 0.63, 1.0, 1.587, 2.52, 4.0];
 struct SuiteRow {
     material: String,
     method: &'static str,
-    mode: EditMode,
+    /// The edit's mode ("paper", "residual"; "-" for the analytic edit).
+    mode: &'static str,
     edit: &'static str,
     outcome: EditOutcome,
     identity_relae: f64,
@@ -115,23 +117,31 @@ fn lobe_summary(rows: &[SuiteRow]) -> String {
         let _ = write!(md, " {}: met / held (passed) |", bar.name());
     }
     md += " dark holes | not measured |\n| --- | --- | ---: | ---: | ---: | ---: | ---: |\n";
-    for method in ["DeepBRDF", "IPCA"] {
-        for mode in [EditMode::Paper, EditMode::Residual] {
-            let sel: Vec<&SuiteRow> =
-                rows.iter().filter(|r| r.method == method && r.mode == mode).collect();
-            if sel.is_empty() {
-                continue;
-            }
-            let t = LobeTally::of(sel.iter().filter_map(|r| r.lobe.as_ref().map(|l| &l.verdict)));
-            let _ = write!(md, "| {method} | {} |", mode.name());
-            for c in t.bars {
-                let _ = write!(md, " {}/{} ({}) |", c.met, c.held, c.passed);
-            }
-            let _ = writeln!(md, " {}/{} | {} |", t.dark_holes, t.edits, sel.len() - t.edits);
+    for (method, mode) in SUITE_METHODS {
+        let sel: Vec<&SuiteRow> =
+            rows.iter().filter(|r| r.method == method && r.mode == mode).collect();
+        if sel.is_empty() {
+            continue;
         }
+        let t = LobeTally::of(sel.iter().filter_map(|r| r.lobe.as_ref().map(|l| &l.verdict)));
+        let _ = write!(md, "| {method} | {mode} |");
+        for c in t.bars {
+            let _ = write!(md, " {}/{} ({}) |", c.met, c.held, c.passed);
+        }
+        let _ = writeln!(md, " {}/{} | {} |", t.dark_holes, t.edits, sel.len() - t.edits);
     }
     md
 }
+
+/// The suite's (representation, mode) pairs, in the order of its tables: each representation's
+/// paper and residual edits, and the analytic edit without a network.
+const SUITE_METHODS: [(&str, &str); 5] = [
+    ("DeepBRDF", "paper"),
+    ("DeepBRDF", "residual"),
+    ("IPCA", "paper"),
+    ("IPCA", "residual"),
+    ("analytic", "-"),
+];
 
 /// A representation with its regressor, and the latent of each material under it.
 struct Rep<'a> {
@@ -334,6 +344,41 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                 None
             }
         };
+        let mut push = |method: &'static str,
+                        mode: &'static str,
+                        edit_name: &'static str,
+                        edit: &Edit,
+                        requested: &Attributes,
+                        edited: &MerlTable|
+         -> anyhow::Result<()> {
+            let achieved = editing::attributes_of(edited, name, &quick)?;
+            let outcome = edit_outcome(original, requested, &achieved, edit.edited());
+            let identity_relae = match edit_name {
+                "identity" => reference.measure(edited)?,
+                _ => f64::NAN,
+            };
+            let p = plausibility(edited);
+            let lobe = match original_lobe.as_ref().map(|o| judge_edit(o, edited, edit)) {
+                Some(Ok(l)) => Some(l),
+                Some(Err(e)) => {
+                    lobe_skipped.push(format!("{name}, {method} {mode} {edit_name}: {e}"));
+                    None
+                }
+                None => None,
+            };
+            rows.push(SuiteRow {
+                material: name.clone(),
+                method,
+                mode,
+                edit: edit_name,
+                outcome,
+                identity_relae,
+                plausible: p.is_plausible(),
+                max_albedo: p.max_albedo,
+                lobe,
+            });
+            Ok(())
+        };
         for rep in reps {
             let latent = rep.space.codec.encode(table)?;
             for mode in [EditMode::Paper, EditMode::Residual] {
@@ -341,38 +386,21 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                     let Ok(edited) = rep.space.edit(&latent, original, &edit, mode) else {
                         continue; // an edit out of range for this material (e.g. x2 past alpha 1)
                     };
-                    let achieved = editing::attributes_of(&edited.table, name, &quick)?;
-                    let outcome =
-                        edit_outcome(original, &edited.requested, &achieved, edit.edited());
-                    let identity_relae = match edit_name {
-                        "identity" => reference.measure(&edited.table)?,
-                        _ => f64::NAN,
-                    };
-                    let p = plausibility(&edited.table);
-                    let lobe =
-                        match original_lobe.as_ref().map(|o| judge_edit(o, &edited.table, &edit)) {
-                            Some(Ok(l)) => Some(l),
-                            Some(Err(e)) => {
-                                let what =
-                                    format!("{name}, {} {} {edit_name}", rep.name, mode.name());
-                                lobe_skipped.push(format!("{what}: {e}"));
-                                None
-                            }
-                            None => None,
-                        };
-                    rows.push(SuiteRow {
-                        material: name.clone(),
-                        method: rep.name,
-                        mode,
-                        edit: edit_name,
-                        outcome,
-                        identity_relae,
-                        plausible: p.is_plausible(),
-                        max_albedo: p.max_albedo,
-                        lobe,
-                    });
+                    push(
+                        rep.name,
+                        mode.name(),
+                        edit_name,
+                        &edit,
+                        &edited.requested,
+                        &edited.table,
+                    )?;
                 }
             }
+        }
+        for (edit_name, edit) in suite_edits(original) {
+            let Ok(requested) = edit.apply(original) else { continue };
+            let edited = analytic_edit(table, original, &requested)?;
+            push("analytic", "-", edit_name, &edit, &requested, &edited)?;
         }
         progress.advance(1);
     }
@@ -385,7 +413,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             "{},{},{},{},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{},{:.6},{}",
             r.material,
             r.method,
-            r.mode.name(),
+            r.mode,
             r.edit,
             o.target_error,
             o.change_ratio,
@@ -406,9 +434,9 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         args.every,
         set.len()
     );
-    for method in ["DeepBRDF", "IPCA"] {
+    for method in ["DeepBRDF", "IPCA", "analytic"] {
         for (edit_name, _) in suite_edits(&attrs[0]) {
-            for mode in [EditMode::Paper, EditMode::Residual] {
+            for (_, mode) in SUITE_METHODS.into_iter().filter(|(m, _)| *m == method) {
                 let sel: Vec<&SuiteRow> = rows
                     .iter()
                     .filter(|r| r.method == method && r.edit == edit_name && r.mode == mode)
@@ -431,8 +459,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                 let show = |v: f64| if v.is_finite() { format!("{v:.3}") } else { "-".into() };
                 let _ = writeln!(
                     md,
-                    "| {method} | {edit_name} | {} | {} | {} | {} | {} | {} | {good}/{} | {} | {plausible}/{} |",
-                    mode.name(),
+                    "| {method} | {edit_name} | {mode} | {} | {} | {} | {} | {} | {good}/{} | {} | {plausible}/{} |",
                     show(f(|o| o.target_error)),
                     show(f(|o| o.change_ratio)),
                     show(f(|o| o.diffuse_drift)),
