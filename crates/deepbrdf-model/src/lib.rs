@@ -1,13 +1,12 @@
 //! `deepbrdf-model`: the DeepBRDF networks on Burn (Hu et al., CGF 2020, §3.2).
 //!
-//! - [`autoencoder`]: the architectures, Table 1, the CPU preset's spectral network
-//!   ([`spectral`], [`principal`]) and the shipped `slice` preset's network shared across phi_d
-//!   slices ([`slice_basis`]); [`loss`]: eq. (4); [`augmentation`]: extra training BRDFs.
+//! - [`autoencoder`]: the architectures, Table 1 and the shipped `slice` preset's network
+//!   shared across phi_d slices ([`slice_basis`]); [`loss`]: eq. (4); [`augmentation`]: extra
+//!   training BRDFs.
 //! - [`train`]: one training loop for every network (schedule, seeded batches, checkpoints
 //!   that resume exactly, NaN stop, CSV log), and the autoencoder's step through it;
 //!   [`training_set`]: the mapped layouts it trains on.
 //! - [`artifact`]: the self-contained saved model; [`codec`]: encode / decode with it;
-//!   [`compact`]: the spectral basis in the compact form the codec decodes with.
 //!   [`refine`]: encoding by optimisation through the decoder.
 //! - [`fit`]: all of the above on a set of MERL tables.
 //! - [`recovery`]: single-image recovery (§5.2): the CNN from a photo to the latent, Fig. 15.
@@ -16,14 +15,12 @@ mod atomic;
 pub mod augmentation;
 pub mod autoencoder;
 pub mod codec;
-pub mod compact;
 mod container;
 pub mod device;
 pub mod error;
 pub mod fit;
 pub mod loss;
 pub mod preset;
-pub mod principal;
 mod read_back;
 mod record;
 pub mod recovery;
@@ -31,7 +28,6 @@ pub mod refine;
 pub mod regressor;
 pub mod seeded;
 pub mod slice_basis;
-pub mod spectral;
 pub mod timing;
 pub mod train;
 pub mod training_set;

@@ -1,5 +1,5 @@
 //! The autoencoder's configuration: the latent dimension k, the leaky ReLU slope and one
-//! [`Architecture`] (Table 1's convolutional network or the `cpu` preset's spectral one), with
+//! [`Architecture`] (Table 1's convolutional network or the `slice` preset's network), with
 //! the two presets and the checks that keep [`AutoencoderConfig::init`] from building a
 //! degenerate network.
 
@@ -9,26 +9,16 @@ use burn::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::convolutional::Convolutional;
-use super::legacy;
+use super::retired;
 use super::slice_network::SliceNetwork;
-use super::spectral_network::SpectralNetwork;
 use super::Autoencoder;
 use crate::augmentation::AugmentationConfig;
 use crate::error::ModelError;
 
-/// K of the `cpu` preset's spectral path: 96 principal directions of the training set (100
-/// materials span 99; with 48 the 51 left out still carried 6e-4 of mapped-space MSE, above what
-/// nearest-slice filling loses from 1/9 of the slices). The basis is stored in the model:
-/// 96 x 4.37 M values, 1.7 GB in f32 while training, 0.67 GB as saved ([`crate::compact`]).
-pub const CPU_SPECTRAL_BASIS: usize = 96;
-/// Width of the `cpu` preset's coefficient-space MLPs.
-pub const CPU_SPECTRAL_HIDDEN: usize = 256;
-
 /// Architecture of the autoencoder: k ([`latent`](Self::latent)) is the FC-10 of Table 1.
 ///
-/// Serialised as `{"latent": k, "negative_slope": s, "architecture": {...}}`; the flat format
-/// of earlier versions (a `convolutional` flag and optional spectral fields) still parses
-/// (see [`super::legacy`]).
+/// Serialised as `{"latent": k, "negative_slope": s, "architecture": {...}}`; a configuration
+/// of a retired network (see [`super::retired`]) is refused with what to do.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "serde_json::Value")]
 pub struct AutoencoderConfig {
@@ -55,9 +45,6 @@ impl std::fmt::Display for AutoencoderConfig {
 pub enum Architecture {
     /// Table 1's convolutional encoder and decoder (and narrower variants of it).
     Convolutional(ConvolutionalConfig),
-    /// The `cpu` preset: MLPs on the coordinates in the training set's principal directions
-    /// ([`crate::spectral`]), around the fixed training mean.
-    Spectral(SpectralConfig),
     /// The `slice` preset: one basis for the (theta_h, theta_d) images of every phi_d slice and
     /// colour, a decoder MLP shared by the slices ([`super::slice_network`]).
     Slice(SliceConfig),
@@ -91,21 +78,7 @@ pub struct ConvolutionalConfig {
     pub he_init: bool,
 }
 
-/// The spectral network of the `cpu` preset (not in the paper, see [`crate::spectral`]).
-#[derive(Config, Debug, PartialEq)]
-pub struct SpectralConfig {
-    /// K, the leading principal directions of the training set the network works on, K >= k
-    /// (set with [`Autoencoder::with_basis`]).
-    pub directions: usize,
-    /// Width of the two coefficient-space MLPs (none: a purely linear path, PCA).
-    #[config(default = "None")]
-    pub hidden: Option<usize>,
-    /// He initialisation of the MLPs' hidden layers (as [`ConvolutionalConfig::he_init`]).
-    #[config(default = false)]
-    pub he_init: bool,
-}
-
-/// The `slice` preset's network ([`super::slice_network`], issue 13; not in the paper).
+/// The `slice` preset's network ([`super::slice_network`]; not in the paper).
 #[derive(Config, Debug, PartialEq)]
 pub struct SliceConfig {
     /// M, the directions of the basis shared by the 540 images of a BRDF.
@@ -151,25 +124,6 @@ impl AutoencoderConfig {
         Self::new(k, Architecture::Convolutional(layers))
     }
 
-    /// The CPU preset: the autoencoder on spectral coordinates ([`crate::spectral`]): the
-    /// input projected on the training set's [`CPU_SPECTRAL_BASIS`] leading principal
-    /// directions (eq. (1) space, centred on the training mean), MLP encoder and decoder of
-    /// width [`CPU_SPECTRAL_HIDDEN`] to and from k (He initialisation), output expanded back to
-    /// 540 x 90 x 90. Not Table 1: on a 2-core CPU the convolutional network cannot leave the
-    /// training mean within the 30-minute budget of `sweep-k` (measured: 18 epochs of a narrow
-    /// variant, 2.5 min, mapped MSE 0.061 against PCA's 0.011 at k = 10), while this trains
-    /// 1000 epochs in seconds.
-    pub fn cpu(k: usize) -> Self {
-        Self::new(
-            k,
-            Architecture::Spectral(
-                SpectralConfig::new(CPU_SPECTRAL_BASIS)
-                    .with_hidden(Some(CPU_SPECTRAL_HIDDEN))
-                    .with_he_init(true),
-            ),
-        )
-    }
-
     /// The `slice` preset ([`super::slice_network`]): a basis of [`SLICE_DIRECTIONS`]
     /// directions shared by all phi_d slices and colours, max(40, k) principal components of
     /// the coefficients, MLPs of width 128, the decoder's shared by the slices; trained with
@@ -195,33 +149,10 @@ impl AutoencoderConfig {
         }
     }
 
-    /// A spectral network ([`crate::spectral`]): latent dimension `k`, `size` principal
-    /// directions, coefficient-space MLPs of width `hidden` (none: linear).
-    /// [`cpu`](Self::cpu) is one, with sizes chosen for the MERL collection.
-    pub fn spectral(k: usize, size: usize, hidden: Option<usize>) -> Self {
-        Self::new(k, Architecture::Spectral(SpectralConfig::new(size).with_hidden(hidden)))
-    }
-
-    /// The spectral network's settings, if it is one (its training runs on coordinates).
-    pub fn spectral_config(&self) -> Option<&SpectralConfig> {
-        match &self.architecture {
-            Architecture::Spectral(s) => Some(s),
-            Architecture::Convolutional(_) | Architecture::Slice(_) => None,
-        }
-    }
-
-    /// Whether the network is spectral: its training runs on coordinates alone and its saved
-    /// basis is compact ([`crate::compact`]).
-    pub fn spectral_only(&self) -> bool {
-        self.spectral_config().is_some()
-    }
-
-    /// Whether the network predicts deviations from a fixed offset (the training mean):
-    /// always for a spectral one, by [`ConvolutionalConfig::mean_offset`] for a convolutional
-    /// one.
+    /// Whether the network predicts deviations from a fixed offset (the training mean): by
+    /// [`ConvolutionalConfig::mean_offset`] for a convolutional one, never for a slice one.
     pub fn mean_offset(&self) -> bool {
         match &self.architecture {
-            Architecture::Spectral(_) => true,
             Architecture::Convolutional(c) => c.mean_offset,
             Architecture::Slice(_) => false,
         }
@@ -273,20 +204,6 @@ impl AutoencoderConfig {
                     )));
                 }
             }
-            Architecture::Spectral(s) => {
-                if s.directions < self.latent || s.directions > MAX_WIDTH {
-                    return Err(ModelError::Invalid(format!(
-                        "a spectral basis of {} directions for k = {} (need k to {MAX_WIDTH})",
-                        s.directions, self.latent
-                    )));
-                }
-                if s.hidden.is_some_and(|h| h == 0 || h > MAX_WIDTH) {
-                    return Err(ModelError::Invalid(format!(
-                        "a spectral MLP width of {:?} is out of range (1 to {MAX_WIDTH})",
-                        s.hidden
-                    )));
-                }
-            }
             Architecture::Slice(s) => {
                 if s.directions == 0 || s.directions > 1024 {
                     return Err(ModelError::Invalid(format!(
@@ -317,40 +234,20 @@ impl AutoencoderConfig {
     /// Seeding and drawing happen under one process-wide lock ([`crate::seeded`]): Burn's
     /// generator is shared by the whole process.
     pub fn init_seeded(&self, seed: u64, device: &Device) -> crate::error::Result<Autoencoder> {
-        crate::seeded::with_seed(seed, device, || self.build(device, true))
-    }
-
-    /// [`init_seeded`](Self::init_seeded) without the spectral path's basis, for a training
-    /// run that fits the basis and sets it ([`Autoencoder::with_basis`]): the same weights,
-    /// without 1.7 GB of zeros (`cpu` preset) in the meantime (no random draw makes the zeros).
-    pub(crate) fn init_seeded_without_basis(
-        &self,
-        seed: u64,
-        device: &Device,
-    ) -> crate::error::Result<Autoencoder> {
-        crate::seeded::with_seed(seed, device, || self.build(device, false))
+        crate::seeded::with_seed(seed, device, || self.build(device))
     }
 
     /// Builds the network on `device` with freshly initialised weights (and a zero offset),
     /// drawn from the device's generator as it stands (under the lock of [`crate::seeded`]).
     pub fn init(&self, device: &Device) -> crate::error::Result<Autoencoder> {
-        crate::seeded::exclusive(|| self.build(device, true))
+        crate::seeded::exclusive(|| self.build(device))
     }
 
-    /// [`init`](Self::init) without the spectral path's basis (`K x 540 x 90 x 90` values),
-    /// for loading the weights of a model whose basis is stored apart ([`crate::compact`]).
-    pub(crate) fn init_without_basis(&self, device: &Device) -> crate::error::Result<Autoencoder> {
-        crate::seeded::exclusive(|| self.build(device, false))
-    }
-
-    fn build(&self, device: &Device, allocate_basis: bool) -> crate::error::Result<Autoencoder> {
+    fn build(&self, device: &Device) -> crate::error::Result<Autoencoder> {
         self.validate()?;
         let model = match &self.architecture {
             Architecture::Convolutional(c) => {
                 Autoencoder::Convolutional(Convolutional::new(self, c, device))
-            }
-            Architecture::Spectral(s) => {
-                Autoencoder::Spectral(SpectralNetwork::new(self, s, allocate_basis, device))
             }
             Architecture::Slice(s) => Autoencoder::Slice(SliceNetwork::new(self, s, device)),
         };
@@ -365,10 +262,10 @@ impl AutoencoderConfig {
 impl TryFrom<serde_json::Value> for AutoencoderConfig {
     type Error = String;
 
-    /// The current format, or the flat one of earlier versions ([`legacy`]).
+    /// The current format; a retired network's configuration is refused ([`retired`]).
     fn try_from(value: serde_json::Value) -> Result<Self, String> {
-        if legacy::is_legacy(&value) {
-            return legacy::upgrade(value);
+        if let Some(what) = retired::retired_network(&value) {
+            return Err(retired::message(what));
         }
         #[derive(Deserialize)]
         #[serde(deny_unknown_fields)]

@@ -21,10 +21,10 @@ use burn::prelude::*;
 use burn::tensor::TensorData;
 
 use super::config::{AutoencoderConfig, SliceConfig};
+use super::mlp::{mlp_forward, mlp_layers};
 use super::{INPUT_CHANNELS, INPUT_SIDE};
 use crate::error::ModelError;
 use crate::slice_basis::SLICE_VALUES;
-use crate::spectral::{mlp_forward, mlp_layers};
 use deepbrdf_data::merl::N_PHI_D;
 
 /// Colour channels of one phi_d slice.

@@ -38,13 +38,6 @@ pub trait TrainStep {
         self.init(device)
     }
 
-    /// What a checkpoint saves of `model`; by default all of it. A step that rebuilds part of
-    /// the network in [`prepare`](Self::prepare) can leave that part out (and out of its
-    /// [`skeleton`](Self::skeleton)).
-    fn checkpointed(&self, model: &Self::Model) -> Self::Model {
-        model.clone()
-    }
-
     /// Called once before the first step, with the new (`fresh`) or resumed network: work the
     /// steps need that is not saved in checkpoints (it must be deterministic). By default
     /// nothing.
@@ -226,7 +219,7 @@ pub fn run<S: TrainStep>(
             progress.batch_done(indices.len(), &state);
             let epoch_done = state.batch == batches;
             if !epoch_done && last_checkpoint.elapsed().as_secs_f64() >= config.checkpoint_seconds {
-                checkpoint::save(&checkpoint, &step.checkpointed(&model), &optim, &state)?;
+                checkpoint::save(&checkpoint, &model, &optim, &state)?;
                 last_checkpoint = Instant::now();
             }
         }
@@ -249,7 +242,7 @@ pub fn run<S: TrainStep>(
             || out_of_time
             || last_checkpoint.elapsed().as_secs_f64() >= config.checkpoint_seconds
         {
-            checkpoint::save(&checkpoint, &step.checkpointed(&model), &optim, &state)?;
+            checkpoint::save(&checkpoint, &model, &optim, &state)?;
             last_checkpoint = Instant::now();
         }
         write_log(&dir.join(LOG_FILE), &state.log)?;

@@ -14,9 +14,9 @@ use burn::prelude::*;
 use deepbrdf_data::Progress;
 
 pub use config::{saved_config, SliceDropoutConfig, TrainConfig};
-pub(crate) use step::{coefficient_gradients, gradients};
+pub(crate) use step::gradients;
 
-use crate::autoencoder::{legacy, Autoencoder, INPUT_VALUES};
+use crate::autoencoder::{retired_message, retired_network, Autoencoder, INPUT_VALUES};
 use crate::error::ModelError;
 use crate::train::checkpoint::{self, checkpoint_path};
 use crate::train::log::EpochRecord;
@@ -107,13 +107,8 @@ fn train_in(
     let path = checkpoint_path(session.dir());
     if path.exists() && session.resumes() {
         let saved = checkpoint::saved_state(&path)?;
-        if saved.config.get("model").is_some_and(legacy::is_legacy) {
-            return Err(ModelError::format(
-                &path,
-                "this checkpoint was written by an earlier version of deepbrdf (before the \
-                 network architectures became variants) and cannot be resumed; a finished run's \
-                 model/ still loads; to train again, start a new run in another directory",
-            ));
+        if let Some(what) = saved.config.get("model").and_then(retired_network) {
+            return Err(ModelError::format(&path, retired_message(what)));
         }
     }
     let fingerprint = data.fingerprint();

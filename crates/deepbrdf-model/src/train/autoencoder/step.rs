@@ -1,23 +1,18 @@
 //! The autoencoder's training step ([`TrainStep`]): its initialisation (seeded, around the
-//! training mean), the basis fit of a spectral network, and the eq. (4) loss and gradients of a
-//! batch, on the full layouts (convolutional networks, in parallel shards) or on the spectral
-//! coordinates (spectral networks, see [`crate::spectral`]).
+//! training mean), and the eq. (4) loss and gradients of a batch, on the full layouts
+//! (convolutional networks, in parallel shards) or on the slice coefficients (slice networks).
 
 use burn::optim::{GradientsParams, MultiGradientsParams};
 use burn::prelude::*;
-use burn::tensor::TensorData;
 use deepbrdf_data::augment::SliceSelection;
 use deepbrdf_data::Progress;
 
-use super::batch::{batch_tensors, filled_coefficients, Augment, Batch};
+use super::batch::{batch_tensors, Augment, Batch};
 use super::config::TrainConfig;
 use super::slice_step::{self, SliceFit};
 use crate::autoencoder::Autoencoder;
-use crate::error::ModelError;
 use crate::loss::masked_mse_centred;
-use crate::principal::PrincipalFit;
-use crate::spectral::SpectralPath;
-use crate::train::run::{on_device, TrainStep};
+use crate::train::run::TrainStep;
 use crate::training_set::TrainingSet;
 
 /// The autoencoder of `config` trained on `data`.
@@ -28,12 +23,6 @@ pub(crate) struct AutoencoderStep<'a> {
     dropout: Option<(f64, Vec<SliceSelection>)>,
     /// The fixed offset, for centring batches on the CPU (see [`Batch`]).
     offset: Option<Vec<f32>>,
-    /// A spectral network's fit of the training set (coordinates and residuals; the basis is
-    /// in the network).
-    fit: Option<PrincipalFit>,
-    /// With slice dropout on coordinates: the coordinates of the filled inputs,
-    /// `[brdf][selection][K]`, computed once.
-    dropout_coefficients: Option<Vec<Vec<Vec<f32>>>>,
     /// A slice network's coefficients of the training samples.
     slice: Option<SliceFit>,
 }
@@ -47,23 +36,7 @@ impl<'a> AutoencoderStep<'a> {
             Some(d) => Some((d.probability, d.parsed()?)),
             None => None,
         };
-        Ok(Self {
-            config,
-            data,
-            dropout,
-            offset: None,
-            fit: None,
-            dropout_coefficients: None,
-            slice: None,
-        })
-    }
-
-    /// Whether `prepare` fits the basis of a spectral network around the training mean (and
-    /// sets it: the network is built without one).
-    fn fits_basis(&self) -> bool {
-        self.config.model.spectral_config().is_some()
-            && self.config.model.mean_offset()
-            && self.config.model.slice_config().is_none()
+        Ok(Self { config, data, dropout, offset: None, slice: None })
     }
 
     /// The number of training samples: the BRDFs, and the augmentations of a slice network.
@@ -88,32 +61,18 @@ impl TrainStep for AutoencoderStep<'_> {
 
     fn skeleton(&mut self, device: &Device) -> crate::error::Result<Autoencoder> {
         // Seeded too: an unseeded draw from the shared generator could fall between the
-        // seeding and the draws of another run's initialisation. A fitted basis is not built
-        // (no zero basis in the meantime: no random draw makes it).
-        match self.fits_basis() {
-            true => self.config.model.init_seeded_without_basis(self.config.seed, device),
-            false => self.config.model.init_seeded(self.config.seed, device),
-        }
+        // seeding and the draws of another run's initialisation.
+        self.config.model.init_seeded(self.config.seed, device)
     }
 
-    /// Checkpoints leave out a fitted basis (1.7 GB for the `cpu` preset): resuming fits it
-    /// again, to the same bits (the fit is deterministic and the data are checked).
-    fn checkpointed(&self, model: &Autoencoder) -> Autoencoder {
-        match self.fits_basis() {
-            true => model.clone().without_basis(),
-            false => model.clone(),
-        }
-    }
-
-    /// Fits a spectral network's basis to the training set (again on resume: the fit is
-    /// deterministic), sets it in a new network, and projects the slice-dropout inputs.
+    /// Fits a slice network's fixed parts to the training set (again on resume: the fit is
+    /// deterministic).
     fn prepare(
         &mut self,
         model: Autoencoder,
         fresh: bool,
         progress: &dyn Progress,
     ) -> crate::error::Result<Autoencoder> {
-        let mut model = model;
         self.offset = model.offset();
         if let Some(layers) = self.config.model.slice_config() {
             let selections = self.dropout.as_ref().map(|(_, s)| s.as_slice());
@@ -128,24 +87,6 @@ impl TrainStep for AutoencoderStep<'_> {
             )?;
             self.slice = Some(fit);
             return Ok(model);
-        }
-        let (Some(spectral), Some(mean)) = (self.config.model.spectral_config(), &self.offset)
-        else {
-            return Ok(model);
-        };
-        progress.status(&format!("fitting {} principal directions", spectral.directions));
-        let mut fit = crate::principal::fit_basis(self.data, mean, spectral.directions)?;
-        // Moved into the network (a resumed one has none: checkpoints leave it out; one
-        // saved with its basis keeps it, the same values); only the coordinates are needed.
-        let basis = std::mem::take(&mut fit.basis);
-        if fresh || !model.spectral().is_some_and(SpectralPath::has_basis) {
-            model = model.with_basis(basis)?;
-        }
-        self.fit = Some(fit);
-        if let Some((_, selections)) = &self.dropout {
-            progress.status("projecting the slice-dropout inputs");
-            self.dropout_coefficients =
-                Some(filled_coefficients(&model, self.data, mean, selections, self.config.seed)?);
         }
         Ok(model)
     }
@@ -177,30 +118,15 @@ impl TrainStep for AutoencoderStep<'_> {
                 .collect();
             return slice_step::slice_gradients(model, fit, indices, inputs, device);
         }
-        match &self.fit {
-            Some(fit) => {
-                let inputs: Vec<f32> = indices
-                    .iter()
-                    .flat_map(|&i| {
-                        let choice = augment.as_ref().and_then(|a| a.choice(i));
-                        match (&self.dropout_coefficients, choice) {
-                            (Some(filled), Some(s)) => filled[i][s].clone(),
-                            _ => fit.coefficients[i].clone(),
-                        }
-                    })
-                    .collect();
-                coefficient_gradients(model, self.data, fit, indices, inputs, device)
-            }
-            None => Ok(gradients(
-                model,
-                self.data,
-                indices,
-                augment.as_ref(),
-                self.offset.as_deref(),
-                self.config.threads,
-                device,
-            )),
-        }
+        Ok(gradients(
+            model,
+            self.data,
+            indices,
+            augment.as_ref(),
+            self.offset.as_deref(),
+            self.config.threads,
+            device,
+        ))
     }
 }
 
@@ -253,31 +179,4 @@ pub(crate) fn gradients(
         grads.grads.push((g, device.clone()));
     }
     (total, grads)
-}
-
-/// The eq. (4) loss of the batch `indices` and its gradients, computed on the spectral
-/// coordinates of a network without convolutions: for orthonormal basis rows, the squared error
-/// of a training BRDF is `|c_hat - c|^2` plus its (fixed) distance to the basis' span.
-pub(crate) fn coefficient_gradients(
-    model: &Autoencoder,
-    data: &TrainingSet,
-    fit: &PrincipalFit,
-    indices: &[usize],
-    inputs: Vec<f32>,
-    device: &Device,
-) -> crate::error::Result<(f32, MultiGradientsParams)> {
-    let path = model
-        .spectral()
-        .ok_or_else(|| ModelError::Invalid("coefficient training needs a spectral path".into()))?;
-    let size = path.size();
-    let valid: f64 = indices.iter().map(|&i| data.valid_values(i)).sum();
-    let residual: f64 = indices.iter().map(|&i| fit.residuals[i]).sum();
-    let values: Vec<f32> = indices.iter().flat_map(|&i| fit.coefficients[i].clone()).collect();
-    let c = Tensor::<2>::from_data(TensorData::new(values, [indices.len(), size]), device);
-    let input = Tensor::<2>::from_data(TensorData::new(inputs, [indices.len(), size]), device);
-    let diff = path.decode(path.encode(input)) - c; // [batch, K]
-    let loss = (diff.clone() * diff).sum().div_scalar(valid.max(1.0)); // [1]
-    let value: f32 = loss.clone().into_scalar();
-    let value = value + (residual / valid.max(1.0)) as f32;
-    Ok((value, on_device(GradientsParams::from_grads(loss.backward(), model), device)))
 }
