@@ -142,7 +142,7 @@ impl DeepBrdf {
     /// from the encoder's latent and the principal-component latent ([`crate::refine`]).
     fn encode_refined(
         &self,
-        net: &crate::autoencoder::slice_network::SliceNetwork,
+        net: &crate::autoencoder::SliceNetwork,
         mut input: Vec<f32>,
         mask: Vec<f32>,
     ) -> Result<Vec<f32>> {

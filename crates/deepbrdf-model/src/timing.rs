@@ -13,10 +13,10 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::artifact::{ModelArtifact, Provenance};
+use crate::autoencoder::convolutional::step::gradients;
 use crate::autoencoder::AutoencoderConfig;
 use crate::codec::DeepBrdf;
 use crate::error::{ModelError, Result};
-use crate::train::autoencoder::gradients;
 use crate::training_set::TrainingSet;
 use deepbrdf_data::merl::grid::valid_mask;
 

@@ -8,15 +8,16 @@
 //! - [`Autoencoder::Convolutional`] ([`convolutional`]): Table 1 exactly
 //!   ([`AutoencoderConfig::paper`]), or narrower variants of it selectable with a
 //!   configuration file, optionally around a fixed offset (the training mean).
-//! - [`Autoencoder::Slice`] ([`slice_network`]): the `slice` preset
+//! - [`Autoencoder::Slice`] ([`slice`]): the `slice` preset
 //!   ([`AutoencoderConfig::slice`]): one basis for the images of all phi_d slices, a decoder
 //!   MLP shared by the slices; small enough to ship.
 
 mod config;
 pub mod convolutional;
-mod mlp;
+mod init;
+mod limits;
 mod retired;
-pub mod slice_network;
+pub mod slice;
 
 use burn::module::Param;
 use burn::prelude::*;
@@ -24,12 +25,10 @@ use burn::tensor::TensorData;
 use deepbrdf_data::layout::{SIDE, SLICE_CHANNELS};
 use deepbrdf_data::merl::VALUES;
 
-pub use config::{
-    Architecture, AutoencoderConfig, ConvolutionalConfig, SliceConfig, SLICE_DIRECTIONS,
-};
-use convolutional::Convolutional;
+pub use config::{Architecture, AutoencoderConfig, NEGATIVE_SLOPE};
+pub use convolutional::{Convolutional, ConvolutionalConfig, BOTTLENECK_SIDE};
 pub(crate) use retired::{message as retired_message, retired_network};
-use slice_network::SliceNetwork;
+pub use slice::{SliceConfig, SliceNetwork, SLICE_DIRECTIONS};
 
 use crate::error::ModelError;
 
@@ -39,8 +38,6 @@ pub const INPUT_CHANNELS: usize = SLICE_CHANNELS;
 pub const INPUT_SIDE: usize = SIDE;
 /// Values of one BRDF in the layout (`540 * 90 * 90`, the MERL table's value count).
 pub const INPUT_VALUES: usize = VALUES;
-/// Side of the bottleneck images after three stride-2 convolutions (90 -> 45 -> 23 -> 12).
-pub const BOTTLENECK_SIDE: usize = 12;
 
 /// The autoencoder of §3.2, one variant per [`Architecture`].
 #[derive(Module, Debug)]
@@ -51,10 +48,36 @@ pub enum Autoencoder {
     Slice(SliceNetwork),
 }
 
-/// A zero offset (set with [`Autoencoder::with_offset`]), not trained.
-fn zero_offset(device: &Device) -> Param<Tensor<3>> {
-    Param::from_tensor(Tensor::zeros([INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE], device))
-        .set_require_grad(false)
+impl AutoencoderConfig {
+    /// [`init`](Self::init) with the weights drawn from `seed`, reproducibly.
+    ///
+    /// Seeding and drawing happen under one process-wide lock ([`crate::seeded`]): Burn's
+    /// generator is shared by the whole process.
+    pub fn init_seeded(&self, seed: u64, device: &Device) -> crate::error::Result<Autoencoder> {
+        crate::seeded::with_seed(seed, device, || self.build(device))
+    }
+
+    /// Builds the network on `device` with freshly initialised weights (and a zero offset),
+    /// drawn from the device's generator as it stands (under the lock of [`crate::seeded`]).
+    pub fn init(&self, device: &Device) -> crate::error::Result<Autoencoder> {
+        crate::seeded::exclusive(|| self.build(device))
+    }
+
+    fn build(&self, device: &Device) -> crate::error::Result<Autoencoder> {
+        self.validate()?;
+        let (k, slope) = (self.latent, self.negative_slope);
+        let model = match &self.architecture {
+            Architecture::Convolutional(c) => {
+                Autoencoder::Convolutional(Convolutional::new(k, slope, c, device))
+            }
+            Architecture::Slice(s) => Autoencoder::Slice(SliceNetwork::new(k, slope, s, device)),
+        };
+        // Burn initialises parameters lazily, on first use, from the device's random generator;
+        // drawing them all now, in a fixed order, keeps a seeded run reproducible even when the
+        // first use happens in parallel training shards.
+        let _ = model.clone().into_record();
+        Ok(model)
+    }
 }
 
 impl Autoencoder {

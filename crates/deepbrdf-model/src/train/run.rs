@@ -1,6 +1,12 @@
 //! The training loop every network shares ([`run`]): epochs of seeded batches, the
 //! network-specific step ([`TrainStep`]: loss and gradients of a batch), Adam with the
 //! learning-rate schedule, the NaN stop, checkpoints and exact resume, the CSV log, progress.
+//!
+//! Not Burn's `burn-train` `Learner`: a run here must resume from a checkpoint taken within an
+//! epoch to the same bits (seeded per-epoch orders, the batch position and the optimizer state
+//! saved together), stop on a non-finite loss keeping the last good checkpoint, and let a step
+//! train on what it prepared itself (the slice network's coefficients) rather than on a
+//! dataloader's items; this loop does that in a few hundred lines.
 
 use std::fs;
 use std::path::Path;
@@ -235,7 +241,7 @@ pub fn run<S: TrainStep>(
         state.samples = 0;
         state.epoch_seconds = 0.0;
         // Every `checkpoint_seconds` and at the end (epochs of small networks take
-        // milliseconds; a checkpoint of the spectral preset holds a ~1 GB basis).
+        // milliseconds: a checkpoint after each would cost more than the epoch).
         let last = state.epoch == config.epochs;
         let out_of_time = !last && deadline.is_some_and(|d| Instant::now() >= d);
         if last

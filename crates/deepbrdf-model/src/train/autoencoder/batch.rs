@@ -1,6 +1,6 @@
 //! One batch of the autoencoder's training data, prepared on the CPU: inputs and targets
-//! centred on the fixed offset and masked, slice dropout (§3.2, Fig. 2) drawn per (seed, epoch,
-//! BRDF), and the spectral coordinates of the filled inputs for training on coordinates.
+//! centred on the fixed offset and masked, and slice dropout (§3.2, Fig. 2) drawn per (seed,
+//! epoch, BRDF), shared by the network families' training steps.
 
 use burn::prelude::*;
 use burn::tensor::TensorData;
@@ -9,8 +9,29 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use crate::autoencoder::{INPUT_CHANNELS, INPUT_SIDE, INPUT_VALUES};
 use crate::training_set::TrainingSet;
+use deepbrdf_data::layout::{
+    LAYOUT_VALUES as INPUT_VALUES, SIDE as INPUT_SIDE, SLICE_CHANNELS as INPUT_CHANNELS,
+};
+
+/// Slice dropout of a run: its probability, its parsed selections and the run's seed.
+pub(crate) struct SliceDropout {
+    pub probability: f64,
+    pub selections: Vec<SliceSelection>,
+    pub seed: u64,
+}
+
+impl SliceDropout {
+    /// The dropout of epoch `epoch` (0-based).
+    pub(crate) fn at_epoch(&self, epoch: usize) -> Augment<'_> {
+        Augment {
+            probability: self.probability,
+            selections: &self.selections,
+            seed: self.seed,
+            epoch,
+        }
+    }
+}
 
 /// Slice dropout applied to one batch.
 pub(crate) struct Augment<'a> {

@@ -9,8 +9,9 @@ use burn::optim::AdamConfig;
 use burn::prelude::*;
 use deepbrdf_data::augment::SliceSelection;
 
+use super::batch::SliceDropout;
 use crate::atomic::read_limited;
-use crate::autoencoder::AutoencoderConfig;
+use crate::autoencoder::{Autoencoder, AutoencoderConfig};
 use crate::error::ModelError;
 use crate::train::checkpoint::{self, CHECKPOINT_FILE};
 use crate::train::config::{adam, LoopConfig};
@@ -148,6 +149,25 @@ impl TrainConfig {
             dropout.parsed()?;
         }
         Ok(())
+    }
+
+    /// Slice dropout's probability and parsed selections with the run's seed, if it is on.
+    pub(crate) fn dropout(&self) -> crate::error::Result<Option<SliceDropout>> {
+        match &self.slice_dropout {
+            Some(d) => Ok(Some(SliceDropout {
+                probability: d.probability,
+                selections: d.parsed()?,
+                seed: self.seed,
+            })),
+            None => Ok(None),
+        }
+    }
+
+    /// The network of a new run, its weights drawn from the run's seed. Seeded even when
+    /// resuming: an unseeded draw from the shared generator could fall between the seeding
+    /// and the draws of another run's initialisation.
+    pub(crate) fn init_network(&self, device: &Device) -> crate::error::Result<Autoencoder> {
+        self.model.init_seeded(self.seed, device)
     }
 
     /// The learning rate of step `step` of `total` ([`LoopConfig::learning_rate_at`]).

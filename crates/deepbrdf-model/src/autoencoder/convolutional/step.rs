@@ -1,54 +1,36 @@
-//! The autoencoder's training step ([`TrainStep`]): its initialisation (seeded, around the
-//! training mean), and the eq. (4) loss and gradients of a batch, on the full layouts
-//! (convolutional networks, in parallel shards) or on the slice coefficients (slice networks).
+//! The convolutional network's training step ([`TrainStep`]): its initialisation (seeded,
+//! around the training mean when it has an offset) and the eq. (4) loss and gradients of a
+//! batch on the full layouts, computed in parallel shards.
 
 use burn::optim::{GradientsParams, MultiGradientsParams};
 use burn::prelude::*;
-use deepbrdf_data::augment::SliceSelection;
-use deepbrdf_data::Progress;
 
-use super::batch::{batch_tensors, Augment, Batch};
-use super::config::TrainConfig;
-use super::slice_step::{self, SliceFit};
 use crate::autoencoder::Autoencoder;
 use crate::loss::masked_mse_centred;
+use crate::train::autoencoder::batch::{batch_tensors, Augment, Batch, SliceDropout};
+use crate::train::autoencoder::config::TrainConfig;
 use crate::train::run::TrainStep;
 use crate::training_set::TrainingSet;
 
-/// The autoencoder of `config` trained on `data`.
-pub(crate) struct AutoencoderStep<'a> {
+/// Table 1's network (or a narrower variant) of `config` trained on `data`.
+pub(crate) struct ConvolutionalStep<'a> {
     config: &'a TrainConfig,
     data: &'a TrainingSet,
-    /// Slice dropout: its probability and selections.
-    dropout: Option<(f64, Vec<SliceSelection>)>,
+    dropout: Option<SliceDropout>,
     /// The fixed offset, for centring batches on the CPU (see [`Batch`]).
     offset: Option<Vec<f32>>,
-    /// A slice network's coefficients of the training samples.
-    slice: Option<SliceFit>,
 }
 
-impl<'a> AutoencoderStep<'a> {
+impl<'a> ConvolutionalStep<'a> {
     pub(crate) fn new(
         config: &'a TrainConfig,
         data: &'a TrainingSet,
     ) -> crate::error::Result<Self> {
-        let dropout = match &config.slice_dropout {
-            Some(d) => Some((d.probability, d.parsed()?)),
-            None => None,
-        };
-        Ok(Self { config, data, dropout, offset: None, slice: None })
-    }
-
-    /// The number of training samples: the BRDFs, and the augmentations of a slice network.
-    pub(crate) fn samples(&self) -> usize {
-        match self.config.model.slice_config() {
-            Some(layers) => layers.augmentation.samples(self.data.len()),
-            None => self.data.len(),
-        }
+        Ok(Self { config, data, dropout: config.dropout()?, offset: None })
     }
 }
 
-impl TrainStep for AutoencoderStep<'_> {
+impl TrainStep for ConvolutionalStep<'_> {
     type Model = Autoencoder;
 
     fn init(&mut self, device: &Device) -> crate::error::Result<Autoencoder> {
@@ -60,34 +42,16 @@ impl TrainStep for AutoencoderStep<'_> {
     }
 
     fn skeleton(&mut self, device: &Device) -> crate::error::Result<Autoencoder> {
-        // Seeded too: an unseeded draw from the shared generator could fall between the
-        // seeding and the draws of another run's initialisation.
-        self.config.model.init_seeded(self.config.seed, device)
+        self.config.init_network(device)
     }
 
-    /// Fits a slice network's fixed parts to the training set (again on resume: the fit is
-    /// deterministic).
     fn prepare(
         &mut self,
         model: Autoencoder,
-        fresh: bool,
-        progress: &dyn Progress,
+        _fresh: bool,
+        _progress: &dyn deepbrdf_data::Progress,
     ) -> crate::error::Result<Autoencoder> {
         self.offset = model.offset();
-        if let Some(layers) = self.config.model.slice_config() {
-            let selections = self.dropout.as_ref().map(|(_, s)| s.as_slice());
-            let (model, fit) = slice_step::prepare(
-                model,
-                self.data,
-                layers,
-                selections,
-                self.config.seed,
-                fresh,
-                progress,
-            )?;
-            self.slice = Some(fit);
-            return Ok(model);
-        }
         Ok(model)
     }
 
@@ -98,26 +62,7 @@ impl TrainStep for AutoencoderStep<'_> {
         indices: &[usize],
         device: &Device,
     ) -> crate::error::Result<(f32, MultiGradientsParams)> {
-        let augment = self.dropout.as_ref().map(|(p, selections)| Augment {
-            probability: *p,
-            selections,
-            seed: self.config.seed,
-            epoch,
-        });
-        if let Some(fit) = &self.slice {
-            let n = self.data.len();
-            let inputs: Vec<f32> = indices
-                .iter()
-                .flat_map(|&i| {
-                    let choice = augment.as_ref().filter(|_| i < n).and_then(|a| a.choice(i));
-                    match (&fit.filled, choice) {
-                        (Some(filled), Some(s)) => filled[i][s].clone(),
-                        _ => fit.target(i).to_vec(),
-                    }
-                })
-                .collect();
-            return slice_step::slice_gradients(model, fit, indices, inputs, device);
-        }
+        let augment = self.dropout.as_ref().map(|d| d.at_epoch(epoch));
         Ok(gradients(
             model,
             self.data,
