@@ -1,11 +1,10 @@
 //! `experiments train-regressor`, `edit`, `interpolate` and `bench edit` end to end with a tiny
-//! spectral model (K = 3 directions, k = 2) on three synthetic materials: the regressor is saved
+//! `slice` model (k = 2, [`util::tiny_train_config`]) on three synthetic materials: the regressor is saved
 //! naming its model, edits write MERL files and bad values are named, a regressor of another
 //! model is refused.
 use crate::util;
 use deepbrdf_data::merl::read_merl;
 use deepbrdf_model::burn::config::Config as _;
-use deepbrdf_model::{AutoencoderConfig, TrainConfig};
 
 use crate::util::s;
 
@@ -20,8 +19,7 @@ fn train_a_regressor_edit_and_interpolate() {
     };
     let mut runs = Vec::new();
     for seed in [0u64, 1] {
-        let mut config = TrainConfig::cpu(2).with_epochs(2).with_batch_size(2).with_seed(seed);
-        config.model = AutoencoderConfig::spectral(2, 3, Some(8));
+        let config = util::tiny_train_config().with_seed(seed);
         let config_path = dir.path().join(format!("tiny{seed}.json"));
         config.save(&config_path).unwrap();
         let run = dir.path().join(format!("run{seed}"));

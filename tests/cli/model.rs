@@ -1,20 +1,19 @@
-//! `experiments train`, `encode`, `decode` and `reconstruct` end to end with a spectral network
-//! (the `cpu` preset's kind, tiny: K = 3 directions, k = 2) on three synthetic MERL files: the
-//! model directory holds the compact basis, the commands chain, a reconstruction of a training
-//! material comes back close, and bad inputs are named.
+//! `experiments train`, `encode`, `decode` and `reconstruct` end to end with a tiny `slice`
+//! network (k = 2, [`util::tiny_train_config`]) on three synthetic MERL files: the commands
+//! chain, a reconstruction of a training material comes back close, bad inputs are named, and
+//! a model directory of a retired format is refused with what to do.
 use crate::util;
 use deepbrdf_data::merl::read_merl;
 use deepbrdf_model::burn::config::Config as _;
-use deepbrdf_model::{AutoencoderConfig, TrainConfig};
+use deepbrdf_model::TrainConfig;
 
 use crate::util::s;
 
 #[test]
-fn train_encode_decode_and_reconstruct_a_spectral_model() {
+fn train_encode_decode_and_reconstruct_a_slice_model() {
     let dir = tempfile::tempdir().unwrap();
     let data = util::write_data(dir.path(), 3);
-    let mut config = TrainConfig::cpu(2).with_epochs(3).with_batch_size(2);
-    config.model = AutoencoderConfig::spectral(2, 3, Some(8));
+    let config = util::tiny_train_config().with_epochs(3);
     let config_path = dir.path().join("tiny.json");
     config.save(&config_path).unwrap();
     let run = dir.path().join("run");
@@ -24,7 +23,6 @@ fn train_encode_decode_and_reconstruct_a_spectral_model() {
         out
     };
     ok(&["train", "--config", &s(&config_path), "--data", &s(&data), "--out", &s(&run)]);
-    assert!(run.join("model").join("basis.f16").is_file(), "the basis is saved compact");
 
     let m1 = s(&data.join("m1.binary"));
     let latent = dir.path().join("m1.json");
@@ -41,7 +39,8 @@ fn train_encode_decode_and_reconstruct_a_spectral_model() {
     let decoded = read_merl(&decoded_path).unwrap();
     assert_eq!(decoded.mask(), original.mask());
     // Three materials span two directions around their mean: k = 2 holds a training material
-    // up to f16 rounding and three epochs of the MLPs (which start at zero).
+    // up to what the 8-direction slice basis loses and three epochs of the MLPs (which start
+    // at zero).
     let mut errors: Vec<f32> = original
         .values()
         .iter()
@@ -87,12 +86,39 @@ fn train_encode_decode_and_reconstruct_a_spectral_model() {
     let missing = s(&dir.path().join("missing.json"));
     let out = util::run_in(dir.path(), &["decode", &s(&run), &missing, "-o", "x.binary"]);
     util::assert_clean_failure(&out, "missing.json");
-    let basis = run.join("model").join("basis.f16");
-    let mut bytes = std::fs::read(&basis).unwrap();
+    let weights = run.join("model").join("weights.bpk");
+    let mut bytes = std::fs::read(&weights).unwrap();
     bytes[100] ^= 0xff;
-    std::fs::write(&basis, bytes).unwrap();
+    std::fs::write(&weights, bytes).unwrap();
     let out = util::run_in(dir.path(), &["encode", &s(&run), &m1]);
-    util::assert_clean_failure(&out, "basis.f16");
+    util::assert_clean_failure(&out, "weights.bpk");
+}
+
+#[test]
+fn a_model_of_the_retired_cpu_preset_is_refused_with_what_to_do() {
+    // A minimal manifest as the `cpu` preset's models had it: the spectral network's
+    // configuration and its compact basis part.
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("old").join("model");
+    std::fs::create_dir_all(&model).unwrap();
+    let part = serde_json::json!({"file": "weights.bpk", "bytes": 1, "sha256": "00"});
+    let manifest = serde_json::json!({
+        "format": "deepbrdf-model", "version": 2, "id": "0123456789abcdef",
+        "config": {"latent": 10, "negative_slope": 0.01,
+            "architecture": {"spectral": {"directions": 96, "hidden": 256, "he_init": true}}},
+        "provenance": {"data_label": "merl", "materials": [], "data_fingerprint": "",
+            "train_config": null, "seed": 0, "epochs": 1000, "final_loss": 0.0,
+            "final_mse": 0.0, "train_seconds": 0.0, "device": "cpu"},
+        "weights": part, "reference": part,
+        "basis": {"file": "basis.f16", "bytes": 1, "sha256": "00"}});
+    std::fs::write(model.join("model.json"), manifest.to_string()).unwrap();
+    let m0 = util::write_data(dir.path(), 1).join("m0.binary");
+    let out = util::run_in(dir.path(), &["encode", &s(&dir.path().join("old")), &s(&m0)]);
+    util::assert_clean_failure(&out, &s(&model));
+    util::assert_clean_failure(&out, "retired format");
+    util::assert_clean_failure(&out, "--preset slice");
+    let out = util::run_in(dir.path(), &["train", "--preset", "cpu", "--out", "x"]);
+    util::assert_clean_failure(&out, "retired");
 }
 
 #[test]
@@ -100,7 +126,7 @@ fn train_names_a_bad_config_file_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let data = util::write_data(dir.path(), 1);
     let saved = dir.path().join("saved.json");
-    TrainConfig::cpu(2).save(&saved).unwrap();
+    TrainConfig::slice(2).save(&saved).unwrap();
     let mut good: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&saved).unwrap()).unwrap();
     assert!(good.get("epochs").is_some(), "{good}");
@@ -188,8 +214,8 @@ fn train_within_a_time_limit_writes_the_epochs_done_and_resumes_to_the_end() {
     let config = util::tiny_config(dir.path());
     let run = dir.path().join("run");
     let args = ["train", "--config", &s(&config), "--data", &s(&data), "--out", &s(&run)];
-    // Any epoch ends past a limit of a millisecond: one epoch of the two, a model, a checkpoint.
-    let out = util::run_in(dir.path(), &[&args[..], &["--time-limit", "0.001"]].concat());
+    // Any epoch ends past a limit of a nanosecond: one epoch of the two, a model, a checkpoint.
+    let out = util::run_in(dir.path(), &[&args[..], &["--time-limit", "1e-9"]].concat());
     assert!(out.status.success(), "{}", util::stderr(&out));
     let text = util::stdout(&out);
     assert!(text.contains("stopped at the time limit after 1 of 2 epochs"), "{text}");

@@ -1,6 +1,6 @@
 //! Single-image recovery end to end on tiny data: `render-set` (a few 16-px images of three
 //! synthetic materials; resumed; a held-out fold), `train-recovery` (the cpu CNN for two
-//! epochs on a tiny spectral model), `recover` (a set image and unusable photos) and the
+//! epochs on a tiny `slice` model), `recover` (a set image and unusable photos) and the
 //! refusal of a network trained for another model.
 use crate::util;
 use deepbrdf_data::merl::read_merl;
@@ -17,7 +17,7 @@ fn render_set_train_recovery_and_recover_chain() {
         assert!(out.status.success(), "{args:?}: {}", util::stderr(&out));
         out
     };
-    // A tiny spectral model (k = 2) on the three materials.
+    // A tiny `slice` model (k = 2) on the three materials.
     let config_path = util::tiny_config(dir.path());
     let model = dir.path().join("model");
     ok(&["train", "--config", &s(&config_path), "--data", &s(&data), "--out", &s(&model)]);

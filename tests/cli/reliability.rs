@@ -119,7 +119,7 @@ fn a_full_disk_and_a_read_only_folder_give_clear_errors_and_keep_what_was_there(
 
 /// The bytes a finished training run leaves that must not depend on how often it was killed.
 fn run_outputs(run: &Path) -> Vec<(String, Vec<u8>)> {
-    kill::files(run, &["model/weights.bpk", "model/basis.f16", "train_log.csv"])
+    kill::files(run, &["model/weights.bpk", "train_log.csv"])
 }
 
 /// `cmd` with its output silenced but for stderr (read when a run fails).
@@ -128,16 +128,16 @@ fn spawn(mut cmd: Command) -> std::process::Child {
     cmd.spawn().expect("spawn experiments")
 }
 
-/// Three synthetic materials in `dir` and a training configuration for them: the cpu preset's
-/// kind of network, tiny, trained `epochs` epochs with a checkpoint after every batch (so kills
+/// Three synthetic materials in `dir` and a training configuration for them: the slice
+/// preset's network, tiny ([`util::tiny_train_config`]), trained `epochs` epochs with a checkpoint after every batch (so kills
 /// land in epochs, in checkpoint writes and in the final save alike). Returns (data, config).
 fn kill_test_setup(dir: &Path, epochs: usize) -> (std::path::PathBuf, std::path::PathBuf) {
     use deepbrdf_model::burn::config::Config as _;
-    use deepbrdf_model::{AutoencoderConfig, TrainConfig};
     let data = util::write_data(dir, 3);
-    let mut config =
-        TrainConfig::cpu(2).with_epochs(epochs).with_batch_size(1).with_checkpoint_seconds(0.0);
-    config.model = AutoencoderConfig::spectral(2, 3, Some(8));
+    let config = util::tiny_train_config()
+        .with_epochs(epochs)
+        .with_batch_size(1)
+        .with_checkpoint_seconds(0.0);
     let config_path = dir.join("tiny.json");
     config.save(&config_path).expect("config");
     (data, config_path)
@@ -197,7 +197,6 @@ fn sweep_k_killed_at_random_moments_continues_to_identical_results() {
                 "robustness.csv",
                 "models/fold0/k1/model/weights.bpk",
                 "models/fold0/k2/model/weights.bpk",
-                "models/fold0/k2/model/basis.f16",
             ],
         )
     };

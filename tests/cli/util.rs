@@ -10,14 +10,27 @@ pub fn s(p: &Path) -> String {
     p.display().to_string()
 }
 
-/// Writes the training configuration of a tiny spectral model (k = 2, 2 epochs, batches of 2:
-/// seconds on three synthetic materials) to `dir/tiny.json` and returns its path.
+/// The `slice` preset's training at a tiny size: k = 2, a slice basis of 8 directions, 2
+/// principal components, MLPs of width 8, one harmonic, no extra training BRDFs, 2 epochs in
+/// batches of 2 (seconds on three synthetic materials).
+pub fn tiny_train_config() -> deepbrdf_model::TrainConfig {
+    use deepbrdf_model::autoencoder::{Architecture, SliceConfig};
+    let layers = SliceConfig::new()
+        .with_directions(8)
+        .with_components(2)
+        .with_hidden(Some(8))
+        .with_harmonics(1)
+        .with_augmentation(deepbrdf_model::augmentation::AugmentationConfig::new());
+    let mut config = deepbrdf_model::TrainConfig::slice(2).with_epochs(2).with_batch_size(2);
+    config.model = deepbrdf_model::AutoencoderConfig::new(2, Architecture::Slice(layers));
+    config
+}
+
+/// Writes [`tiny_train_config`] to `dir/tiny.json` and returns its path.
 pub fn tiny_config(dir: &Path) -> std::path::PathBuf {
     use deepbrdf_model::burn::config::Config as _;
-    let mut config = deepbrdf_model::TrainConfig::cpu(2).with_epochs(2).with_batch_size(2);
-    config.model = deepbrdf_model::AutoencoderConfig::spectral(2, 3, Some(8));
     let path = dir.join("tiny.json");
-    config.save(&path).expect("writing the training configuration");
+    tiny_train_config().save(&path).expect("writing the training configuration");
     path
 }
 

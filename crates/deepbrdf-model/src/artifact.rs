@@ -7,12 +7,11 @@
 //!   weights.bpk            the network's parameters (burnpack, Burn's record format)
 //!   median_reference.bin   the eq. (1) reference of the training data (deepbrdf-data format,
 //!                          written zstd-compressed)
-//!   basis.f16              spectral-only networks (the `cpu` preset): the basis, compact
-//!                          (crate::compact: its support, f16); weights.bpk then lacks it
 //! ```
 //!
-//! Version 1 directories (the basis in f32 inside `weights.bpk`, no `basis.f16`) still load.
-//! The id is a SHA-256 over the configuration, the provenance and the checksums of the parts,
+//! A directory of a retired network (with the `basis.f16` of the retired `cpu` preset, or the
+//! flat configuration of earlier versions) is refused with what to do
+//! ([`crate::autoencoder::retired_network`]). The id is a SHA-256 over the configuration, the provenance and the checksums of the parts,
 //! so editing `model.json` or swapping in the weights or reference of another model is detected
 //! when loading. The directory is written beside its destination and renamed into place.
 
@@ -25,8 +24,7 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 use crate::atomic::{read_limited, write_atomic};
-use crate::autoencoder::{legacy, Autoencoder, AutoencoderConfig};
-use crate::compact::CompactBasis;
+use crate::autoencoder::{retired_network, Autoencoder, AutoencoderConfig};
 use crate::error::{ModelError, Result};
 use crate::train::Trained;
 use deepbrdf_data::files::sync_dir_of;
@@ -37,8 +35,6 @@ pub const MANIFEST_FILE: &str = "model.json";
 pub const WEIGHTS_FILE: &str = "weights.bpk";
 /// File name of the median reference.
 pub const REFERENCE_FILE: &str = "median_reference.bin";
-/// File name of the compact spectral basis.
-pub const BASIS_FILE: &str = "basis.f16";
 /// Name of the artifact directory that training writes inside its output directory.
 pub const MODEL_DIR: &str = "model";
 const FORMAT: &str = "deepbrdf-model";
@@ -108,22 +104,21 @@ struct Manifest {
     format: String,
     version: u32,
     id: String,
-    /// The network's configuration as it was written (and hashed into the id): the current
-    /// format or the flat one of earlier versions.
+    /// The network's configuration as it was written (and hashed into the id).
     config: serde_json::Value,
     provenance: Provenance,
     weights: Part,
     reference: Part,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    basis: Option<Part>,
+    /// Only in models of the retired `cpu` preset: refused when present.
+    #[serde(default, skip_serializing)]
+    basis: Option<serde_json::Value>,
 }
 
-/// The checksums of an artifact's parts, computed once (hashing a basis takes seconds).
+/// The checksums of an artifact's parts, computed once.
 #[derive(Debug, Clone)]
 struct Parts {
     weights: Part,
     reference: Part,
-    basis: Option<Part>,
 }
 
 /// A trained model with its median reference and provenance, in memory.
@@ -134,8 +129,6 @@ pub struct ModelArtifact {
     config_json: serde_json::Value,
     provenance: Provenance,
     weights: Vec<u8>,
-    /// A spectral-only network's basis, serialised compact ([`CompactBasis::to_bytes`]).
-    basis: Option<Vec<u8>>,
     reference: MedianReference,
     parts: Parts,
     id: String,
@@ -164,8 +157,7 @@ impl ModelArtifact {
             train_seconds: trained.seconds,
             device: format!("{device:?}"),
         };
-        // The network is moved in: its basis is taken out without a copy (1.7 GB, `cpu`).
-        Self::assemble(trained.config.model.clone(), provenance, trained.model, reference, true)
+        Self::assemble(trained.config.model.clone(), provenance, trained.model, reference)
     }
 
     /// Bundles a network, its configuration, reference and provenance.
@@ -175,31 +167,15 @@ impl ModelArtifact {
         model: &Autoencoder,
         reference: MedianReference,
     ) -> Result<Self> {
-        Self::assemble(config, provenance, model.clone(), reference, true)
-    }
-
-    /// A spectral-only network's basis left inside the weights in f32, as version 1 saved it.
-    #[cfg(test)]
-    pub(crate) fn new_uncompacted(
-        config: AutoencoderConfig,
-        provenance: Provenance,
-        model: &Autoencoder,
-        reference: MedianReference,
-    ) -> Result<Self> {
-        Self::assemble(config, provenance, model.clone(), reference, false)
+        Self::assemble(config, provenance, model.clone(), reference)
     }
 
     fn assemble(
         config: AutoencoderConfig,
         provenance: Provenance,
-        mut model: Autoencoder,
+        model: Autoencoder,
         reference: MedianReference,
-        compact: bool,
     ) -> Result<Self> {
-        let basis = match compact && config.spectral_only() {
-            true => Some(CompactBasis::take_from(&mut model)?.to_bytes()),
-            false => None,
-        };
         let weights = model
             .into_record()
             .into_bytes()
@@ -211,12 +187,11 @@ impl ModelArtifact {
         let parts = Parts {
             weights: part_of(&weights, WEIGHTS_FILE),
             reference: reference_part(&reference),
-            basis: basis.as_ref().map(|b| part_of(b, BASIS_FILE)),
         };
         let config_json = serde_json::to_value(&config)
             .map_err(|e| ModelError::Invalid(format!("cannot serialise the configuration: {e}")))?;
         let id = manifest_id(&config_json, &provenance, &parts);
-        Ok(Self { config, config_json, provenance, weights, basis, reference, parts, id })
+        Ok(Self { config, config_json, provenance, weights, reference, parts, id })
     }
 
     /// The id tying configuration, provenance, weights and reference together.
@@ -239,48 +214,17 @@ impl ModelArtifact {
         &self.reference
     }
 
-    /// Builds the whole network on `device` and loads the weights into it. A network whose
-    /// basis is stored compact cannot be rebuilt in f32: use [`crate::DeepBrdf`] for it.
+    /// Builds the network on `device` and loads the weights into it.
     pub fn model(&self, device: &Device) -> Result<Autoencoder> {
-        if self.basis.is_some() {
-            return Err(ModelError::Invalid(
-                "this model's spectral basis is stored compact (f16); load it with DeepBrdf".into(),
-            ));
-        }
-        self.load_weights(self.config.init(device)?, self.weights.clone())
+        load_weights(self.config.init(device)?, self.weights.clone())
     }
 
-    /// The network and, for a spectral-only one saved with it, its compact basis (the network
-    /// then lacks its own basis: it can run its coordinate-space MLPs only), without keeping a
-    /// copy of the weights: the artifact keeps its configuration, provenance, reference and id,
-    /// and can no longer be saved or loaded into a network again.
-    pub fn take_model(&mut self, device: &Device) -> Result<(Autoencoder, Option<CompactBasis>)> {
+    /// The network, without keeping a copy of the weights: the artifact keeps its
+    /// configuration, provenance, reference and id, and can no longer be saved or loaded into
+    /// a network again.
+    pub fn take_model(&mut self, device: &Device) -> Result<Autoencoder> {
         let weights = std::mem::take(&mut self.weights);
-        let Some(bytes) = self.basis.take() else {
-            return Ok((self.load_weights(self.config.init(device)?, weights)?, None));
-        };
-        let basis = CompactBasis::from_bytes(&bytes)
-            .map_err(|e| ModelError::Invalid(format!("{BASIS_FILE}: {e}")))?;
-        let directions = self.config.spectral_config().map(|s| s.directions);
-        if Some(basis.size()) != directions {
-            return Err(ModelError::Invalid(format!(
-                "{BASIS_FILE} has {} directions, the configuration {directions:?}",
-                basis.size(),
-            )));
-        }
-        Ok((self.load_weights(self.config.init_without_basis(device)?, weights)?, Some(basis)))
-    }
-
-    /// Loads burnpack `weights` into `network`; weights of a model saved before the
-    /// architectures became enum variants get their parameter paths upgraded first.
-    fn load_weights(&self, network: Autoencoder, weights: Vec<u8>) -> Result<Autoencoder> {
-        let weights = match legacy::is_legacy(&self.config_json) {
-            true => legacy::upgrade_record(weights, &self.config).map_err(|e| {
-                ModelError::Invalid(format!("{WEIGHTS_FILE} of model {}: {e}", self.id))
-            })?,
-            false => weights,
-        };
-        load_weights(network, weights)
+        load_weights(self.config.init(device)?, weights)
     }
 
     /// Writes the artifact directory `dir` (created beside it, then renamed into place).
@@ -294,9 +238,6 @@ impl ModelArtifact {
 
     fn write_parts(&self, dir: &Path) -> Result<()> {
         write_atomic(&dir.join(WEIGHTS_FILE), &[&self.weights])?;
-        if let Some(basis) = &self.basis {
-            write_atomic(&dir.join(BASIS_FILE), &[basis])?;
-        }
         self.reference.save_compressed(dir.join(REFERENCE_FILE))?;
         let manifest = Manifest {
             format: FORMAT.into(),
@@ -306,7 +247,7 @@ impl ModelArtifact {
             provenance: self.provenance.clone(),
             weights: self.parts.weights.clone(),
             reference: self.parts.reference.clone(),
-            basis: self.parts.basis.clone(),
+            basis: None,
         };
         let json = serde_json::to_string_pretty(&manifest)
             .map_err(|e| ModelError::Invalid(format!("cannot serialise the manifest: {e}")))?;
@@ -328,23 +269,6 @@ impl ModelArtifact {
                 format!("these weights do not belong to model {} (checksum differs)", manifest.id),
             ));
         }
-        let basis = match &manifest.basis {
-            Some(part) => {
-                let basis_path = dir.join(BASIS_FILE);
-                let bytes = read_limited(&basis_path, 4 << 30)?;
-                if &part_of(&bytes, BASIS_FILE) != part {
-                    return Err(ModelError::mismatch(
-                        &basis_path,
-                        format!(
-                            "this basis does not belong to model {} (checksum differs)",
-                            manifest.id
-                        ),
-                    ));
-                }
-                Some(bytes)
-            }
-            None => None,
-        };
         let reference_path = dir.join(REFERENCE_FILE);
         let reference = MedianReference::load(&reference_path)?;
         if reference_part(&reference) != manifest.reference {
@@ -356,11 +280,7 @@ impl ModelArtifact {
                 ),
             ));
         }
-        let parts = Parts {
-            weights: manifest.weights,
-            reference: manifest.reference,
-            basis: manifest.basis,
-        };
+        let parts = Parts { weights: manifest.weights, reference: manifest.reference };
         if manifest_id(&manifest.config, &manifest.provenance, &parts) != manifest.id {
             return Err(ModelError::mismatch(
                 &manifest_path,
@@ -372,7 +292,6 @@ impl ModelArtifact {
             config_json: manifest.config,
             provenance: manifest.provenance,
             weights,
-            basis,
             reference,
             parts,
             id: manifest.id,
@@ -394,6 +313,14 @@ fn parse_manifest(path: &Path, text: &[u8]) -> Result<(Manifest, AutoencoderConf
             ),
         ));
     }
+    let retired = match manifest.basis.is_some() {
+        true => Some("the spectral network of the retired `cpu` preset, with its basis.f16"),
+        false => retired_network(&manifest.config),
+    };
+    if let Some(what) = retired {
+        let dir = path.parent().unwrap_or(path);
+        return Err(ModelError::format(dir, crate::autoencoder::retired_message(what)));
+    }
     let config = AutoencoderConfig::try_from(manifest.config.clone())
         .map_err(|e| ModelError::format(path, format!("bad network configuration: {e}")))?;
     config.validate()?;
@@ -414,18 +341,14 @@ fn reference_part(reference: &MedianReference) -> Part {
     }
 }
 
-/// The id over configuration, provenance and the parts' checksums. A version 1 model (no
-/// basis part) keeps its id: the basis enters only when present.
+/// The id over configuration, provenance and the parts' checksums.
 fn manifest_id(config: &serde_json::Value, provenance: &Provenance, parts: &Parts) -> String {
-    let mut content = serde_json::json!({
+    let content = serde_json::json!({
         "config": config,
         "provenance": provenance,
         "weights": parts.weights,
         "reference": parts.reference,
     });
-    if let Some(basis) = &parts.basis {
-        content["basis"] = serde_json::json!(basis);
-    }
     let digest = Sha256::digest(canonical(content).to_string().as_bytes());
     hex::encode(&digest[..16])
 }
@@ -541,100 +464,5 @@ fn replace_dir(tmp: &Path, dir: &Path) -> Result<()> {
 mod fuzz;
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::device::DeviceKind;
-    use deepbrdf_data::merl::VALUES;
-
-    pub(super) fn tiny() -> AutoencoderConfig {
-        let layers = crate::autoencoder::ConvolutionalConfig::new()
-            .with_projection(Some(1))
-            .with_encoder_channels([1, 1, 1])
-            .with_residual_blocks(1)
-            .with_decoder_channels([1, 1])
-            .with_mean_offset(true);
-        AutoencoderConfig::convolutional(2, layers)
-    }
-
-    pub(super) fn provenance() -> Provenance {
-        Provenance {
-            data_label: "synthetic".into(),
-            materials: vec!["a".into(), "b".into()],
-            data_fingerprint: "00".into(),
-            train_config: serde_json::json!({"seed": 1}),
-            seed: 1,
-            epochs: 3,
-            final_loss: 0.593_586_030_006_408_7,
-            final_mse: 0.25,
-            train_seconds: 339.123_456_789,
-            device: "test".into(),
-        }
-    }
-
-    fn copy_dir(from: &Path, to: &Path) {
-        fs::create_dir_all(to).unwrap();
-        for entry in fs::read_dir(from).unwrap() {
-            let entry = entry.unwrap();
-            fs::copy(entry.path(), to.join(entry.file_name())).unwrap();
-        }
-    }
-
-    #[test]
-    fn saved_artifacts_load_and_mismatched_parts_are_detected() {
-        let device = DeviceKind::default_kind().unwrap().device().unwrap();
-        let model_a = tiny().init_seeded(1, &device).unwrap();
-        let model_b = tiny().init_seeded(2, &device).unwrap();
-        let ref_a = MedianReference::from_values(vec![0.25; VALUES]).unwrap();
-        let ref_b = MedianReference::from_values(vec![0.5; VALUES]).unwrap();
-        let a = ModelArtifact::new(tiny(), provenance(), &model_a, ref_a).unwrap();
-        let b = ModelArtifact::new(tiny(), provenance(), &model_b, ref_b).unwrap();
-        assert_ne!(a.id(), b.id());
-
-        let root = tempfile::tempdir().unwrap();
-        let (dir_a, dir_b) = (root.path().join("run").join(MODEL_DIR), root.path().join("b"));
-        fs::create_dir_all(root.path().join("run")).unwrap();
-        a.save(&dir_a).unwrap();
-        a.save(&dir_a).unwrap(); // replacing an artifact is allowed
-        b.save(&dir_b).unwrap();
-        let back = ModelArtifact::load(&dir_a).unwrap();
-        assert_eq!(back.id(), a.id());
-        assert!((back.provenance().final_loss - provenance().final_loss).abs() < 1e-15);
-        // A training directory resolves to its model/.
-        assert_eq!(ModelArtifact::load(&root.path().join("run")).unwrap().id(), a.id());
-        // The loaded weights are the saved ones.
-        let z = Tensor::<2>::from_floats([[0.3, -0.7]], &device);
-        let expected: Vec<f32> = model_a.decode(z.clone()).into_data().try_into_vec().unwrap();
-        let got: Vec<f32> =
-            back.model(&device).unwrap().decode(z).into_data().try_into_vec().unwrap();
-        assert_eq!(expected, got);
-
-        for (file, what) in [(WEIGHTS_FILE, "weights"), (REFERENCE_FILE, "median reference")] {
-            let mixed = root.path().join(format!("mixed-{what}"));
-            copy_dir(&dir_a, &mixed);
-            fs::copy(dir_b.join(file), mixed.join(file)).unwrap();
-            let err = ModelArtifact::load(&mixed).unwrap_err().to_string();
-            assert!(err.contains(file) && err.contains("not belong"), "{err}");
-        }
-        let edited = root.path().join("edited");
-        copy_dir(&dir_a, &edited);
-        let text = fs::read_to_string(edited.join(MANIFEST_FILE)).unwrap();
-        fs::write(
-            edited.join(MANIFEST_FILE),
-            text.replace("\"final_mse\": 0.25", "\"final_mse\": 0.01"),
-        )
-        .unwrap();
-        let err = ModelArtifact::load(&edited).unwrap_err().to_string();
-        assert!(err.contains("edited"), "{err}");
-        fs::write(edited.join(MANIFEST_FILE), "{ not json").unwrap();
-        assert!(ModelArtifact::load(&edited).unwrap_err().to_string().contains("model.json"));
-
-        // Never replaces a directory that is not a model, nor loads from one.
-        let user = root.path().join("user");
-        fs::create_dir_all(&user).unwrap();
-        fs::write(user.join("notes.txt"), "mine").unwrap();
-        assert!(a.save(&user).is_err());
-        assert_eq!(fs::read_to_string(user.join("notes.txt")).unwrap(), "mine");
-        assert!(ModelArtifact::load(&user).is_err());
-        assert!(ModelArtifact::load(&root.path().join("missing")).is_err());
-    }
-}
+#[path = "artifact_tests.rs"]
+mod tests;

@@ -1,8 +1,8 @@
-//! Fuzzing of the model artifact's readers (the reliability issue): the manifest parser with its
-//! configuration checks, the burnpack weights loader and the compact basis parser, each fed
-//! mutants of a real saved part ([`deepbrdf_data::testing::mutate`]). The weights and basis
-//! readers are called directly, past the manifest's checksums that would refuse every mutant
-//! before them, as if a damaged part had been sealed by a matching manifest.
+//! Fuzzing of the model artifact's readers: the manifest parser with its configuration checks
+//! and the burnpack weights loader, each fed mutants of a real saved part
+//! ([`deepbrdf_data::testing::mutate`]). The weights reader is called directly, past the
+//! manifest's checksums that would refuse every mutant before it, as if a damaged part had
+//! been sealed by a matching manifest.
 //!
 //! `DEEPBRDF_FUZZ_INPUTS=1000000 cargo test --release -p deepbrdf-model mutated_model_parts --
 //! --nocapture` runs a million inputs per reader; the test suite runs a few thousand.
@@ -15,7 +15,6 @@ use deepbrdf_data::testing::mutate::{fuzz, inputs, Focus, Report};
 
 use super::tests::{provenance, tiny};
 use super::*;
-use crate::autoencoder::INPUT_VALUES;
 use crate::device::DeviceKind;
 
 fn check(name: &str, report: &Report, started: std::time::Instant) {
@@ -67,17 +66,4 @@ fn mutated_model_parts_are_refused_or_read_never_a_panic() {
     let t = std::time::Instant::now();
     let report = fuzz(&[weights], 22, n, focus, |b| load_weights(network.clone(), b.to_vec()));
     check("weights.bpk", &report, t);
-
-    // The compact basis: two directions on a support of 64 layout values.
-    let mut rows = vec![0f32; 2 * INPUT_VALUES];
-    for i in 0..64 {
-        rows[i * 997] = 0.5 - i as f32 / 64.0;
-        rows[INPUT_VALUES + i * 997] = 1e-3 * i as f32;
-    }
-    let basis = CompactBasis::new(&rows, 2, &vec![0f32; INPUT_VALUES]).unwrap().to_bytes();
-    CompactBasis::from_bytes(&basis).unwrap();
-    let focus = Focus { header: 64, header_share: 0.6 };
-    let t = std::time::Instant::now();
-    let report = fuzz(&[basis], 23, n, focus, |b| CompactBasis::from_bytes(b));
-    check("basis.f16", &report, t);
 }

@@ -1,42 +1,36 @@
 //! `deepbrdf-model`: the DeepBRDF networks on Burn (Hu et al., CGF 2020, §3.2).
 //!
-//! - [`autoencoder`]: the architectures, Table 1, the CPU preset's spectral network
-//!   ([`spectral`], [`principal`]) and the shipped `slice` preset's network shared across phi_d
-//!   slices ([`slice_basis`]); [`loss`]: eq. (4); [`augmentation`]: extra training BRDFs.
+//! - [`autoencoder`]: the architectures, one folder per network family: Table 1
+//!   ([`autoencoder::convolutional`]) and the shipped `slice` preset's network shared across
+//!   phi_d slices ([`autoencoder::slice`]: its basis, extra training BRDFs ([`augmentation`])
+//!   and encoding by optimisation through the decoder ([`refine`])); [`loss`]: eq. (4).
 //! - [`train`]: one training loop for every network (schedule, seeded batches, checkpoints
-//!   that resume exactly, NaN stop, CSV log), and the autoencoder's step through it;
-//!   [`training_set`]: the mapped layouts it trains on.
-//! - [`artifact`]: the self-contained saved model; [`codec`]: encode / decode with it;
-//!   [`compact`]: the spectral basis in the compact form the codec decodes with.
-//!   [`refine`]: encoding by optimisation through the decoder.
+//!   that resume exactly, NaN stop, CSV log), and the autoencoder's training through it, each
+//!   family with its own step; [`training_set`]: the mapped layouts it trains on.
+//! - [`artifact`]: the self-contained saved model; [`codec`]: encode / decode with it.
 //! - [`fit`]: all of the above on a set of MERL tables.
 //! - [`recovery`]: single-image recovery (§5.2): the CNN from a photo to the latent, Fig. 15.
 pub mod artifact;
 mod atomic;
-pub mod augmentation;
 pub mod autoencoder;
 pub mod codec;
-pub mod compact;
 mod container;
 pub mod device;
 pub mod error;
 pub mod fit;
 pub mod loss;
 pub mod preset;
-pub mod principal;
 mod read_back;
 mod record;
 pub mod recovery;
-pub mod refine;
 pub mod regressor;
 pub mod seeded;
-pub mod slice_basis;
-pub mod spectral;
 pub mod timing;
 pub mod train;
 pub mod training_set;
 
 pub use artifact::{ModelArtifact, Provenance};
+pub use autoencoder::slice::{augmentation, refine};
 pub use autoencoder::{Autoencoder, AutoencoderConfig};
 pub use burn;
 pub use codec::DeepBrdf;

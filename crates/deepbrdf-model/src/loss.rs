@@ -6,8 +6,8 @@
 //! independent of the batch size, and equals the mapped-space MSE the evaluation reports.
 //!
 //! [`colour_weights`] weighs a training sample's colour channels in that error by how much a
-//! mapped error moves a rendering of the sample, relative to the rendering's brightness (issue
-//! 13; not in the paper): the image-space RelAE the evaluation reports.
+//! mapped error moves a rendering of the sample, relative to the rendering's brightness (not in
+//! the paper): the image-space RelAE the evaluation reports.
 
 use burn::prelude::*;
 use deepbrdf_data::layout::layout_index;

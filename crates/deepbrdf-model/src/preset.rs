@@ -1,5 +1,5 @@
-//! Named settings: `paper` (Table 1 and §3.2's training), `cpu` (sized for a 2-core CPU) and
-//! `slice` (the network shared across phi_d slices that ships as the default model).
+//! Named settings: `paper` (Table 1 and §3.2's training) and `slice` (the network shared
+//! across phi_d slices that ships as the default model).
 
 use std::fmt;
 use std::str::FromStr;
@@ -12,8 +12,6 @@ use crate::train::TrainConfig;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Preset {
-    /// Sized for a 2-core CPU: see [`crate::AutoencoderConfig::cpu`] and [`TrainConfig::cpu`].
-    Cpu,
     /// The paper: Table 1, Adam lr 2e-5, batches of 32, 1000 epochs (for GPUs).
     Paper,
     /// One basis and one decoder MLP shared by all phi_d slices, small enough to ship: see
@@ -22,13 +20,12 @@ pub enum Preset {
 }
 
 impl Preset {
-    /// Both presets.
-    pub const ALL: [Preset; 3] = [Preset::Cpu, Preset::Paper, Preset::Slice];
+    /// Every preset.
+    pub const ALL: [Preset; 2] = [Preset::Paper, Preset::Slice];
 
     /// The preset's training configuration for latent dimension `k`.
     pub fn train_config(self, k: usize) -> TrainConfig {
         match self {
-            Preset::Cpu => TrainConfig::cpu(k),
             Preset::Paper => TrainConfig::paper(k),
             Preset::Slice => TrainConfig::slice(k),
         }
@@ -37,7 +34,6 @@ impl Preset {
     /// The preset's name.
     pub fn name(self) -> &'static str {
         match self {
-            Preset::Cpu => "cpu",
             Preset::Paper => "paper",
             Preset::Slice => "slice",
         }
@@ -54,9 +50,11 @@ impl FromStr for Preset {
     type Err = String;
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::ALL
-            .into_iter()
-            .find(|p| p.name().eq_ignore_ascii_case(s.trim()))
-            .ok_or_else(|| format!("unknown preset '{s}': expected cpu, paper or slice"))
+        Self::ALL.into_iter().find(|p| p.name().eq_ignore_ascii_case(s.trim())).ok_or_else(|| {
+            match s.trim().eq_ignore_ascii_case("cpu") {
+                true => format!("the preset '{s}' was retired: use slice (the shipped model's)"),
+                false => format!("unknown preset '{s}': expected paper or slice"),
+            }
+        })
     }
 }

@@ -6,7 +6,6 @@
 use std::time::Instant;
 
 use burn::prelude::*;
-use burn::tensor::TensorData;
 use deepbrdf_data::layout::mask_layout;
 use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::merl::VALUES;
@@ -14,10 +13,10 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::artifact::{ModelArtifact, Provenance};
-use crate::autoencoder::{AutoencoderConfig, INPUT_VALUES};
+use crate::autoencoder::convolutional::step::gradients;
+use crate::autoencoder::AutoencoderConfig;
 use crate::codec::DeepBrdf;
 use crate::error::{ModelError, Result};
-use crate::train::autoencoder::{coefficient_gradients, gradients};
 use crate::training_set::TrainingSet;
 use deepbrdf_data::merl::grid::valid_mask;
 
@@ -41,9 +40,9 @@ impl Timing {
 }
 
 /// Times `steps` training steps (after one warm-up step) on batches of `batch` BRDFs, exactly
-/// as training runs them: batch preparation on the CPU, forward, eq. (4) loss, backward, Adam
-/// (for a network without convolutions, the step on spectral coordinates; the basis fit, done
-/// once per training run, is not timed).
+/// as a convolutional network's training runs them: batch preparation on the CPU, forward,
+/// eq. (4) loss, backward, Adam (a slice network's fixed parts are left at zero: speed does not
+/// depend on their values).
 pub fn training_steps(
     config: &AutoencoderConfig,
     batch: usize,
@@ -61,26 +60,13 @@ pub fn training_steps(
         model = model.with_offset(&set.mean())?;
     }
     let offset = model.offset();
-    let fit = match (config.spectral_config(), &offset) {
-        (Some(spectral), Some(mean)) => {
-            let mut fit = crate::principal::fit_basis(&set, mean, spectral.directions)?;
-            model = model.with_basis(std::mem::take(&mut fit.basis))?;
-            Some(fit)
-        }
-        _ => None,
-    };
     let mut optim = crate::train::adam().init();
     let indices: Vec<usize> = (0..batch).collect();
     let mut runs = Vec::with_capacity(steps);
     for step in 0..=steps {
         let start = Instant::now();
-        let (value, grads) = match &fit {
-            Some(fit) => {
-                let inputs = indices.iter().flat_map(|&i| fit.coefficients[i].clone()).collect();
-                coefficient_gradients(&model, &set, fit, &indices, inputs, &device)?
-            }
-            None => gradients(&model, &set, &indices, None, offset.as_deref(), threads, &device),
-        };
+        let (value, grads) =
+            gradients(&model, &set, &indices, None, offset.as_deref(), threads, &device);
         model = optim.step_multi(1e-5, model, grads);
         device.sync().map_err(|e| ModelError::Invalid(format!("device error: {e:?}")))?;
         if !value.is_finite() {
@@ -110,16 +96,11 @@ pub struct DecodeTiming {
     pub network: Timing,
     /// The whole decode: network, inverse layout, inverse eq. (1) on the grid's valid cells.
     pub whole: Timing,
-    /// For a spectral-only network, the same network part through the network's own f32
-    /// matrix product with the full basis (what the codec's compact basis replaces), timed in
-    /// the same run as the baseline.
-    pub f32_network: Option<Timing>,
 }
 
 /// Times decoding one latent vector into a full MERL table through [`DeepBrdf`], as `decode`
-/// and the evaluation use it, over `repeats` runs after one warm-up. A spectral network gets a
-/// basis and offset of seeded random values on the grid's valid cells (speed does not depend on
-/// the values, but the compact basis does depend on their support).
+/// and the evaluation use it, over `repeats` runs after one warm-up. A network with an offset
+/// gets one of seeded random values on the grid's valid cells (speed does not depend on them).
 pub fn decode(config: &AutoencoderConfig, repeats: usize, device: &Device) -> Result<DecodeTiming> {
     let device = device.clone().without_autodiff();
     let mut model = config.init_seeded(0, &device)?;
@@ -129,24 +110,7 @@ pub fn decode(config: &AutoencoderConfig, repeats: usize, device: &Device) -> Re
         let offset: Vec<f32> = valid.iter().map(|&m| m * rng.random_range(-1.0..1.0f32)).collect();
         model = model.with_offset(&offset)?;
     }
-    if let Some(size) = config.spectral_config().map(|s| s.directions) {
-        let scale = 1.0 / (INPUT_VALUES as f32).sqrt();
-        let basis: Vec<f32> = (0..size * INPUT_VALUES)
-            .map(|i| valid[i % INPUT_VALUES] * scale * rng.random_range(-1.0..1.0f32))
-            .collect();
-        model = model.with_basis(basis)?;
-    }
     let latent: Vec<f32> = (0..config.latent).map(|i| 0.1 * (i as f32 - 2.0)).collect();
-    let f32_network = match config.spectral_only() {
-        true => Some(timed(repeats, || {
-            let z = Tensor::<2>::from_data(
-                TensorData::new(latent.clone(), [1, config.latent]),
-                &device,
-            );
-            crate::read_back::values(model.decode(z), "the decoded layout")
-        })?),
-        false => None,
-    };
     let provenance = Provenance::untrained("benchmark", 0);
     let reference = MedianReference::from_values(vec![0.05; VALUES])?;
     let artifact = ModelArtifact::new(config.clone(), provenance, &model, reference)?;
@@ -154,7 +118,7 @@ pub fn decode(config: &AutoencoderConfig, repeats: usize, device: &Device) -> Re
     let codec = DeepBrdf::from_artifact(artifact, &device)?;
     let network = timed(repeats, || codec.decode_layout(&latent))?;
     let whole = timed(repeats, || codec.decode(&latent))?;
-    Ok(DecodeTiming { network, whole, f32_network })
+    Ok(DecodeTiming { network, whole })
 }
 
 /// Times `repeats` runs of `f` (at least one) after one untimed warm-up.

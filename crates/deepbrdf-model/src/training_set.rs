@@ -3,14 +3,13 @@
 
 use std::sync::Arc;
 
-use deepbrdf_data::layout::{mask_layout, to_layout};
+use deepbrdf_data::layout::{mask_layout, to_layout, LAYOUT_VALUES};
 use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::table_set::TableSet;
 use deepbrdf_data::MerlTable;
 use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 
-use crate::autoencoder::INPUT_VALUES;
 use crate::error::{ModelError, Result};
 
 /// Named BRDFs in the mapped §3.2 layout, ready to batch.
@@ -25,7 +24,7 @@ pub struct TrainingSet {
     masks: Vec<Arc<Vec<f32>>>,
     valid: Vec<f64>,
     /// The eq. (1) reference in layout order, for a set built from tables (augmentation maps
-    /// through it, [`crate::augmentation`]).
+    /// through it, [`crate::autoencoder::slice::augmentation`]).
     reference: Option<Arc<Vec<f32>>>,
 }
 
@@ -74,9 +73,9 @@ impl TrainingSet {
         }
         for (i, (input, mask)) in inputs.iter().zip(&masks).enumerate() {
             let name = &names[i];
-            if input.len() != INPUT_VALUES || mask.len() != INPUT_VALUES {
+            if input.len() != LAYOUT_VALUES || mask.len() != LAYOUT_VALUES {
                 return Err(ModelError::Invalid(format!(
-                    "{name}: a layout has {INPUT_VALUES} values, got {} values and {} mask entries",
+                    "{name}: a layout has {LAYOUT_VALUES} values, got {} values and {} mask entries",
                     input.len(),
                     mask.len()
                 )));
@@ -201,8 +200,8 @@ impl TrainingSet {
     /// Per-value mean over the BRDFs valid there (0 where none is): the offset of the CPU
     /// preset, and the prediction a network with zero output makes.
     pub fn mean(&self) -> Vec<f32> {
-        let mut sum = vec![0f64; INPUT_VALUES];
-        let mut count = vec![0u32; INPUT_VALUES];
+        let mut sum = vec![0f64; LAYOUT_VALUES];
+        let mut count = vec![0u32; LAYOUT_VALUES];
         for (input, mask) in self.inputs.iter().zip(&self.masks) {
             for ((s, c), (&x, &m)) in
                 sum.iter_mut().zip(count.iter_mut()).zip(input.iter().zip(mask.iter()))
@@ -227,7 +226,7 @@ impl TrainingSet {
         for (i, name) in self.names.iter().enumerate() {
             hasher.update((name.len() as u64).to_le_bytes());
             hasher.update(name.as_bytes());
-            for j in (i % 97..INPUT_VALUES).step_by(97) {
+            for j in (i % 97..LAYOUT_VALUES).step_by(97) {
                 hasher.update(self.inputs[i][j].to_le_bytes());
                 hasher.update(self.masks[i][j].to_le_bytes());
             }
@@ -236,18 +235,12 @@ impl TrainingSet {
     }
 }
 
-/// The mapped layout of `table` (eq. 1, then §3.2's reordering; invalid cells 0) and its mask
-/// in the same layout.
-pub fn layout_of(table: &MerlTable, reference: &MedianReference) -> (Vec<f32>, Vec<f32>) {
-    (to_layout(&reference.map(table)), mask_layout(&table.mask()))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn layout(v: f32) -> Vec<f32> {
-        vec![v; INPUT_VALUES]
+        vec![v; LAYOUT_VALUES]
     }
 
     #[test]

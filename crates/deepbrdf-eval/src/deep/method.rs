@@ -15,7 +15,7 @@ use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_model::artifact::MODEL_DIR;
 use deepbrdf_model::burn::tensor::Device;
 use deepbrdf_model::refine::Refinement;
-use deepbrdf_model::train::{json_close, CHECKPOINT_FILE};
+use deepbrdf_model::train::json_close;
 use deepbrdf_model::{DeepBrdf, ModelArtifact, TrainConfig, TrainingSet as MappedSet};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
@@ -146,7 +146,6 @@ impl DeepMethod {
         k: usize,
         cache: &Arc<InputCache>,
         set: &mut Option<MappedSet>,
-        fold_models: &mut Vec<Arc<DeepBrdf>>,
         progress: &dyn Progress,
     ) -> Result<Box<dyn Codec>> {
         let names = train.names;
@@ -193,25 +192,13 @@ impl DeepMethod {
                         &self.device,
                     )?;
                     artifact.save(&dir.join(MODEL_DIR))?;
-                    if config.model.spectral_only() {
-                        // Retraining takes seconds; the checkpoint (the f32 network,
-                        // 1.7 GB) would more than double the 0.7 GB model on disk. The
-                        // saved model is what a rerun loads.
-                        let _ = std::fs::remove_file(dir.join(CHECKPOINT_FILE));
-                    }
                     DeepBrdf::from_artifact(artifact, &self.device)
                 })
                 .map_err(|e| model_error(&dir, e))?;
                 (model, FitOrigin::Trained)
             }
         };
-        // The fold's models at other k fitted the same basis: keep one copy of it.
-        let mut model = model.with_refinement(self.refinement);
-        for other in fold_models.iter() {
-            if model.share_basis(other) {
-                break;
-            }
-        }
+        let model = model.with_refinement(self.refinement);
         let provenance = model.provenance();
         let record = FitRecord {
             fold,
@@ -226,7 +213,6 @@ impl DeepMethod {
             fits.push(record);
         }
         let model = Arc::new(model);
-        fold_models.push(Arc::clone(&model));
         let mut models = self.models.lock().map_err(|_| poisoned())?;
         // Codecs of one fold share the mapped input of the table being evaluated when their
         // models map with the same eq. (1) reference (they do: one fold, one training set).
@@ -309,7 +295,7 @@ impl Method for DeepMethod {
         let indices: Vec<usize> = (0..tables.len()).collect();
         let set =
             FoldTraining { fold: 0, set: &tables, indices: &indices, names, reference: &reference };
-        self.fit_in(set.fold, &set, k, &Arc::default(), &mut None, &mut Vec::new(), progress)
+        self.fit_in(set.fold, &set, k, &Arc::default(), &mut None, progress)
     }
 
     fn fit_fold(
@@ -321,10 +307,9 @@ impl Method for DeepMethod {
         let fold = train.fold;
         let cache = Arc::new(InputCache::default());
         let mut set = None;
-        let mut fold_models = Vec::new();
         let codecs = ks
             .iter()
-            .map(|&k| self.fit_in(fold, train, k, &cache, &mut set, &mut fold_models, progress))
+            .map(|&k| self.fit_in(fold, train, k, &cache, &mut set, progress))
             .collect::<Result<Vec<_>>>()?;
         Ok(codecs)
     }

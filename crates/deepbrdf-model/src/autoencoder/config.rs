@@ -1,34 +1,24 @@
 //! The autoencoder's configuration: the latent dimension k, the leaky ReLU slope and one
-//! [`Architecture`] (Table 1's convolutional network or the `cpu` preset's spectral one), with
+//! [`Architecture`] (Table 1's convolutional network or the `slice` preset's network), with
 //! the two presets and the checks that keep [`AutoencoderConfig::init`] from building a
 //! degenerate network.
 
 use burn::config::Config;
-use burn::nn::Initializer;
-use burn::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::convolutional::Convolutional;
-use super::legacy;
-use super::slice_network::SliceNetwork;
-use super::spectral_network::SpectralNetwork;
-use super::Autoencoder;
-use crate::augmentation::AugmentationConfig;
+use super::convolutional::ConvolutionalConfig;
+use super::limits::MAX_WIDTH;
+use super::retired;
+use super::slice::SliceConfig;
 use crate::error::ModelError;
 
-/// K of the `cpu` preset's spectral path: 96 principal directions of the training set (100
-/// materials span 99; with 48 the 51 left out still carried 6e-4 of mapped-space MSE, above what
-/// nearest-slice filling loses from 1/9 of the slices). The basis is stored in the model:
-/// 96 x 4.37 M values, 1.7 GB in f32 while training, 0.67 GB as saved ([`crate::compact`]).
-pub const CPU_SPECTRAL_BASIS: usize = 96;
-/// Width of the `cpu` preset's coefficient-space MLPs.
-pub const CPU_SPECTRAL_HIDDEN: usize = 256;
+/// PyTorch's default negative slope of the leaky ReLU (the paper does not give one).
+pub const NEGATIVE_SLOPE: f64 = 0.01;
 
 /// Architecture of the autoencoder: k ([`latent`](Self::latent)) is the FC-10 of Table 1.
 ///
-/// Serialised as `{"latent": k, "negative_slope": s, "architecture": {...}}`; the flat format
-/// of earlier versions (a `convolutional` flag and optional spectral fields) still parses
-/// (see [`super::legacy`]).
+/// Serialised as `{"latent": k, "negative_slope": s, "architecture": {...}}`; a configuration
+/// of a retired network (see [`super::retired`]) is refused with what to do.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "serde_json::Value")]
 pub struct AutoencoderConfig {
@@ -49,96 +39,21 @@ impl std::fmt::Display for AutoencoderConfig {
 }
 
 /// The networks an autoencoder can be. New ones (say, a network for a new input layout) are new
-/// variants here and in [`Autoencoder`].
+/// variants here and in [`super::Autoencoder`], each in its own folder.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Architecture {
     /// Table 1's convolutional encoder and decoder (and narrower variants of it).
     Convolutional(ConvolutionalConfig),
-    /// The `cpu` preset: MLPs on the coordinates in the training set's principal directions
-    /// ([`crate::spectral`]), around the fixed training mean.
-    Spectral(SpectralConfig),
     /// The `slice` preset: one basis for the (theta_h, theta_d) images of every phi_d slice and
-    /// colour, a decoder MLP shared by the slices ([`super::slice_network`]).
+    /// colour, a decoder MLP shared by the slices ([`super::slice`]).
     Slice(SliceConfig),
 }
-
-/// The layers of Table 1's convolutional network.
-#[derive(Config, Debug, PartialEq)]
-pub struct ConvolutionalConfig {
-    /// Width C of a per-pixel 1x1 projection 540 -> C applied first (and C -> 540 applied
-    /// last); `None` in Table 1, where the strided convolutions see all 540 channels.
-    #[config(default = "None")]
-    pub projection: Option<usize>,
-    /// Output channels of the three 3x3 stride-2 convolutions (Table 1: 256, 128, 64).
-    #[config(default = "[256, 128, 64]")]
-    pub encoder_channels: [usize; 3],
-    /// Number of residual blocks at the bottleneck (Table 1: 3).
-    #[config(default = 3)]
-    pub residual_blocks: usize,
-    /// Output channels of the first two deconvolutions (Table 1: 128 at 24 x 24, 256 at 48 x 48).
-    #[config(default = "[128, 256]")]
-    pub decoder_channels: [usize; 2],
-    /// Predict deviations from a fixed per-value offset (the training mean in mapped space,
-    /// set with [`Autoencoder::with_offset`]); the input is centred on it too. Not in Table 1.
-    #[config(default = false)]
-    pub mean_offset: bool,
-    /// He initialisation (normal, gain sqrt(2) for the leaky ReLUs, the residual blocks'
-    /// second convolutions at zero so they start as identities) instead of PyTorch's default
-    /// (uniform, gain 1/sqrt(3)), under which activations shrink layer after layer and the
-    /// latent vector starts near zero. Not a Table 1 setting; training converges much faster.
-    #[config(default = false)]
-    pub he_init: bool,
-}
-
-/// The spectral network of the `cpu` preset (not in the paper, see [`crate::spectral`]).
-#[derive(Config, Debug, PartialEq)]
-pub struct SpectralConfig {
-    /// K, the leading principal directions of the training set the network works on, K >= k
-    /// (set with [`Autoencoder::with_basis`]).
-    pub directions: usize,
-    /// Width of the two coefficient-space MLPs (none: a purely linear path, PCA).
-    #[config(default = "None")]
-    pub hidden: Option<usize>,
-    /// He initialisation of the MLPs' hidden layers (as [`ConvolutionalConfig::he_init`]).
-    #[config(default = false)]
-    pub he_init: bool,
-}
-
-/// The `slice` preset's network ([`super::slice_network`], issue 13; not in the paper).
-#[derive(Config, Debug, PartialEq)]
-pub struct SliceConfig {
-    /// M, the directions of the basis shared by the 540 images of a BRDF.
-    #[config(default = 64)]
-    pub directions: usize,
-    /// K >= k, the principal components of the coefficient vectors the encoder MLP sees (the
-    /// first k are the linear path).
-    #[config(default = 40)]
-    pub components: usize,
-    /// Width of the encoder MLP and of the decoder MLP shared by the slices (none: linear,
-    /// PCA within the slice basis' span).
-    #[config(default = "Some(128)")]
-    pub hidden: Option<usize>,
-    /// H, the Fourier harmonics of phi_d the decoder MLP sees.
-    #[config(default = 4)]
-    pub harmonics: usize,
-    /// Extra training BRDFs (channel permutations, mixtures), used by the fits of the mean
-    /// and components and by training.
-    #[config(default = "AugmentationConfig::new()")]
-    pub augmentation: AugmentationConfig,
-}
-
-/// M of the `slice` preset.
-pub const SLICE_DIRECTIONS: usize = 64;
-
-/// Largest layer width, latent dimension or basis size accepted (a guard against typos that
-/// would allocate terabytes).
-const MAX_WIDTH: usize = 4096;
 
 impl AutoencoderConfig {
     /// A network of `architecture` with latent dimension `k` and PyTorch's leaky ReLU slope.
     pub fn new(k: usize, architecture: Architecture) -> Self {
-        Self { latent: k, negative_slope: 0.01, architecture }
+        Self { latent: k, negative_slope: NEGATIVE_SLOPE, architecture }
     }
 
     /// Table 1 exactly, with latent dimension `k`.
@@ -151,40 +66,11 @@ impl AutoencoderConfig {
         Self::new(k, Architecture::Convolutional(layers))
     }
 
-    /// The CPU preset: the autoencoder on spectral coordinates ([`crate::spectral`]): the
-    /// input projected on the training set's [`CPU_SPECTRAL_BASIS`] leading principal
-    /// directions (eq. (1) space, centred on the training mean), MLP encoder and decoder of
-    /// width [`CPU_SPECTRAL_HIDDEN`] to and from k (He initialisation), output expanded back to
-    /// 540 x 90 x 90. Not Table 1: on a 2-core CPU the convolutional network cannot leave the
-    /// training mean within the 30-minute budget of `sweep-k` (measured: 18 epochs of a narrow
-    /// variant, 2.5 min, mapped MSE 0.061 against PCA's 0.011 at k = 10), while this trains
-    /// 1000 epochs in seconds.
-    pub fn cpu(k: usize) -> Self {
-        Self::new(
-            k,
-            Architecture::Spectral(
-                SpectralConfig::new(CPU_SPECTRAL_BASIS)
-                    .with_hidden(Some(CPU_SPECTRAL_HIDDEN))
-                    .with_he_init(true),
-            ),
-        )
-    }
-
-    /// The `slice` preset ([`super::slice_network`]): a basis of [`SLICE_DIRECTIONS`]
-    /// directions shared by all phi_d slices and colours, max(40, k) principal components of
-    /// the coefficients, MLPs of width 128, the decoder's shared by the slices; trained with
-    /// channel permutations and pairwise mixtures of the training BRDFs
-    /// ([`AugmentationConfig`]). The whole network is ~2 M values: it ships.
+    /// The `slice` preset ([`super::slice`], [`SliceConfig::preset`]): a basis shared by all
+    /// phi_d slices and colours, principal components of the coefficients, MLPs, the
+    /// decoder's shared by the slices; small enough to ship.
     pub fn slice(k: usize) -> Self {
-        Self::new(
-            k,
-            Architecture::Slice(
-                SliceConfig::new()
-                    .with_directions(SLICE_DIRECTIONS)
-                    .with_components(k.max(40))
-                    .with_augmentation(AugmentationConfig::preset()),
-            ),
-        )
+        Self::new(k, Architecture::Slice(SliceConfig::preset(k)))
     }
 
     /// The slice network's settings, if it is one.
@@ -195,51 +81,12 @@ impl AutoencoderConfig {
         }
     }
 
-    /// A spectral network ([`crate::spectral`]): latent dimension `k`, `size` principal
-    /// directions, coefficient-space MLPs of width `hidden` (none: linear).
-    /// [`cpu`](Self::cpu) is one, with sizes chosen for the MERL collection.
-    pub fn spectral(k: usize, size: usize, hidden: Option<usize>) -> Self {
-        Self::new(k, Architecture::Spectral(SpectralConfig::new(size).with_hidden(hidden)))
-    }
-
-    /// The spectral network's settings, if it is one (its training runs on coordinates).
-    pub fn spectral_config(&self) -> Option<&SpectralConfig> {
-        match &self.architecture {
-            Architecture::Spectral(s) => Some(s),
-            Architecture::Convolutional(_) | Architecture::Slice(_) => None,
-        }
-    }
-
-    /// Whether the network is spectral: its training runs on coordinates alone and its saved
-    /// basis is compact ([`crate::compact`]).
-    pub fn spectral_only(&self) -> bool {
-        self.spectral_config().is_some()
-    }
-
-    /// Whether the network predicts deviations from a fixed offset (the training mean):
-    /// always for a spectral one, by [`ConvolutionalConfig::mean_offset`] for a convolutional
-    /// one.
+    /// Whether the network predicts deviations from a fixed offset (the training mean): by
+    /// [`ConvolutionalConfig::mean_offset`] for a convolutional one, never for a slice one.
     pub fn mean_offset(&self) -> bool {
         match &self.architecture {
-            Architecture::Spectral(_) => true,
             Architecture::Convolutional(c) => c.mean_offset,
             Architecture::Slice(_) => false,
-        }
-    }
-
-    /// The initializer of hidden layers (followed by a leaky ReLU) and of linear outputs.
-    pub(super) fn initializers(&self, he_init: bool) -> (Initializer, Initializer) {
-        if he_init {
-            let slope = self.negative_slope;
-            let gain = (2.0 / (1.0 + slope * slope)).sqrt();
-            (
-                Initializer::KaimingNormal { gain, fan_out_only: false },
-                Initializer::KaimingNormal { gain: 1.0, fan_out_only: false },
-            )
-        } else {
-            let default =
-                Initializer::KaimingUniform { gain: 1.0 / 3f64.sqrt(), fan_out_only: false };
-            (default.clone(), default)
         }
     }
 
@@ -255,120 +102,19 @@ impl AutoencoderConfig {
             return Err(ModelError::Invalid("the leaky ReLU slope must be finite".into()));
         }
         match &self.architecture {
-            Architecture::Convolutional(c) => {
-                let widths = c
-                    .encoder_channels
-                    .iter()
-                    .chain(c.decoder_channels.iter())
-                    .chain(c.projection.iter());
-                if let Some(w) = widths.into_iter().find(|&&w| w == 0 || w > MAX_WIDTH) {
-                    return Err(ModelError::Invalid(format!(
-                        "a layer width of {w} is out of range (1 to {MAX_WIDTH})"
-                    )));
-                }
-                if c.residual_blocks > 64 {
-                    return Err(ModelError::Invalid(format!(
-                        "{} residual blocks is out of range (0 to 64)",
-                        c.residual_blocks
-                    )));
-                }
-            }
-            Architecture::Spectral(s) => {
-                if s.directions < self.latent || s.directions > MAX_WIDTH {
-                    return Err(ModelError::Invalid(format!(
-                        "a spectral basis of {} directions for k = {} (need k to {MAX_WIDTH})",
-                        s.directions, self.latent
-                    )));
-                }
-                if s.hidden.is_some_and(|h| h == 0 || h > MAX_WIDTH) {
-                    return Err(ModelError::Invalid(format!(
-                        "a spectral MLP width of {:?} is out of range (1 to {MAX_WIDTH})",
-                        s.hidden
-                    )));
-                }
-            }
-            Architecture::Slice(s) => {
-                if s.directions == 0 || s.directions > 1024 {
-                    return Err(ModelError::Invalid(format!(
-                        "a slice basis of {} directions is out of range (1 to 1024)",
-                        s.directions
-                    )));
-                }
-                if s.components < self.latent || s.components > MAX_WIDTH {
-                    return Err(ModelError::Invalid(format!(
-                        "{} principal components for k = {} (need k to {MAX_WIDTH})",
-                        s.components, self.latent
-                    )));
-                }
-                if s.hidden.is_some_and(|h| h == 0 || h > MAX_WIDTH) || s.harmonics > 64 {
-                    return Err(ModelError::Invalid(format!(
-                        "a slice MLP width of {:?} or {} harmonics is out of range",
-                        s.hidden, s.harmonics
-                    )));
-                }
-                s.augmentation.validate()?;
-            }
+            Architecture::Convolutional(c) => c.validate(),
+            Architecture::Slice(s) => s.validate(self.latent),
         }
-        Ok(())
-    }
-
-    /// [`init`](Self::init) with the weights drawn from `seed`, reproducibly.
-    ///
-    /// Seeding and drawing happen under one process-wide lock ([`crate::seeded`]): Burn's
-    /// generator is shared by the whole process.
-    pub fn init_seeded(&self, seed: u64, device: &Device) -> crate::error::Result<Autoencoder> {
-        crate::seeded::with_seed(seed, device, || self.build(device, true))
-    }
-
-    /// [`init_seeded`](Self::init_seeded) without the spectral path's basis, for a training
-    /// run that fits the basis and sets it ([`Autoencoder::with_basis`]): the same weights,
-    /// without 1.7 GB of zeros (`cpu` preset) in the meantime (no random draw makes the zeros).
-    pub(crate) fn init_seeded_without_basis(
-        &self,
-        seed: u64,
-        device: &Device,
-    ) -> crate::error::Result<Autoencoder> {
-        crate::seeded::with_seed(seed, device, || self.build(device, false))
-    }
-
-    /// Builds the network on `device` with freshly initialised weights (and a zero offset),
-    /// drawn from the device's generator as it stands (under the lock of [`crate::seeded`]).
-    pub fn init(&self, device: &Device) -> crate::error::Result<Autoencoder> {
-        crate::seeded::exclusive(|| self.build(device, true))
-    }
-
-    /// [`init`](Self::init) without the spectral path's basis (`K x 540 x 90 x 90` values),
-    /// for loading the weights of a model whose basis is stored apart ([`crate::compact`]).
-    pub(crate) fn init_without_basis(&self, device: &Device) -> crate::error::Result<Autoencoder> {
-        crate::seeded::exclusive(|| self.build(device, false))
-    }
-
-    fn build(&self, device: &Device, allocate_basis: bool) -> crate::error::Result<Autoencoder> {
-        self.validate()?;
-        let model = match &self.architecture {
-            Architecture::Convolutional(c) => {
-                Autoencoder::Convolutional(Convolutional::new(self, c, device))
-            }
-            Architecture::Spectral(s) => {
-                Autoencoder::Spectral(SpectralNetwork::new(self, s, allocate_basis, device))
-            }
-            Architecture::Slice(s) => Autoencoder::Slice(SliceNetwork::new(self, s, device)),
-        };
-        // Burn initialises parameters lazily, on first use, from the device's random generator;
-        // drawing them all now, in a fixed order, keeps a seeded run reproducible even when the
-        // first use happens in parallel training shards.
-        let _ = model.clone().into_record();
-        Ok(model)
     }
 }
 
 impl TryFrom<serde_json::Value> for AutoencoderConfig {
     type Error = String;
 
-    /// The current format, or the flat one of earlier versions ([`legacy`]).
+    /// The current format; a retired network's configuration is refused ([`retired`]).
     fn try_from(value: serde_json::Value) -> Result<Self, String> {
-        if legacy::is_legacy(&value) {
-            return legacy::upgrade(value);
+        if let Some(what) = retired::retired_network(&value) {
+            return Err(retired::message(what));
         }
         #[derive(Deserialize)]
         #[serde(deny_unknown_fields)]
@@ -379,7 +125,7 @@ impl TryFrom<serde_json::Value> for AutoencoderConfig {
             architecture: Architecture,
         }
         fn default_slope() -> f64 {
-            0.01
+            NEGATIVE_SLOPE
         }
         let c: Current = serde_json::from_value(value.clone()).map_err(|e| e.to_string())?;
         let config = Self {

@@ -8,19 +8,16 @@
 //! - [`Autoencoder::Convolutional`] ([`convolutional`]): Table 1 exactly
 //!   ([`AutoencoderConfig::paper`]), or narrower variants of it selectable with a
 //!   configuration file, optionally around a fixed offset (the training mean).
-//! - [`Autoencoder::Spectral`] ([`spectral_network`]): the `cpu` preset
-//!   ([`AutoencoderConfig::cpu`]), not a CNN: MLPs on the coordinates of the input in the
-//!   training set's leading principal directions, around the training mean
-//!   ([`crate::spectral`]; the README says why and what it costs).
-//! - [`Autoencoder::Slice`] ([`slice_network`]): the `slice` preset
+//! - [`Autoencoder::Slice`] ([`slice`]): the `slice` preset
 //!   ([`AutoencoderConfig::slice`]): one basis for the images of all phi_d slices, a decoder
 //!   MLP shared by the slices; small enough to ship.
 
 mod config;
 pub mod convolutional;
-pub(crate) mod legacy;
-pub mod slice_network;
-pub mod spectral_network;
+mod init;
+mod limits;
+mod retired;
+pub mod slice;
 
 use burn::module::Param;
 use burn::prelude::*;
@@ -28,16 +25,12 @@ use burn::tensor::TensorData;
 use deepbrdf_data::layout::{SIDE, SLICE_CHANNELS};
 use deepbrdf_data::merl::VALUES;
 
-pub use config::{
-    Architecture, AutoencoderConfig, ConvolutionalConfig, SliceConfig, SpectralConfig,
-    CPU_SPECTRAL_BASIS, CPU_SPECTRAL_HIDDEN, SLICE_DIRECTIONS,
-};
-use convolutional::Convolutional;
-use slice_network::SliceNetwork;
-use spectral_network::SpectralNetwork;
+pub use config::{Architecture, AutoencoderConfig, NEGATIVE_SLOPE};
+pub use convolutional::{Convolutional, ConvolutionalConfig, BOTTLENECK_SIDE};
+pub(crate) use retired::{message as retired_message, retired_network};
+pub use slice::{SliceConfig, SliceNetwork, SLICE_DIRECTIONS};
 
 use crate::error::ModelError;
-use crate::spectral::SpectralPath;
 
 /// Channels of the §3.2 layout: 180 phi_d slices x 3 colour channels.
 pub const INPUT_CHANNELS: usize = SLICE_CHANNELS;
@@ -45,31 +38,52 @@ pub const INPUT_CHANNELS: usize = SLICE_CHANNELS;
 pub const INPUT_SIDE: usize = SIDE;
 /// Values of one BRDF in the layout (`540 * 90 * 90`, the MERL table's value count).
 pub const INPUT_VALUES: usize = VALUES;
-/// Side of the bottleneck images after three stride-2 convolutions (90 -> 45 -> 23 -> 12).
-pub const BOTTLENECK_SIDE: usize = 12;
 
 /// The autoencoder of §3.2, one variant per [`Architecture`].
 #[derive(Module, Debug)]
 pub enum Autoencoder {
     /// Table 1 (and narrower variants).
     Convolutional(Convolutional),
-    /// The `cpu` preset's network on spectral coordinates.
-    Spectral(SpectralNetwork),
     /// The `slice` preset's network shared across phi_d slices.
     Slice(SliceNetwork),
 }
 
-/// A zero offset (set with [`Autoencoder::with_offset`]), not trained.
-fn zero_offset(device: &Device) -> Param<Tensor<3>> {
-    Param::from_tensor(Tensor::zeros([INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE], device))
-        .set_require_grad(false)
+impl AutoencoderConfig {
+    /// [`init`](Self::init) with the weights drawn from `seed`, reproducibly.
+    ///
+    /// Seeding and drawing happen under one process-wide lock ([`crate::seeded`]): Burn's
+    /// generator is shared by the whole process.
+    pub fn init_seeded(&self, seed: u64, device: &Device) -> crate::error::Result<Autoencoder> {
+        crate::seeded::with_seed(seed, device, || self.build(device))
+    }
+
+    /// Builds the network on `device` with freshly initialised weights (and a zero offset),
+    /// drawn from the device's generator as it stands (under the lock of [`crate::seeded`]).
+    pub fn init(&self, device: &Device) -> crate::error::Result<Autoencoder> {
+        crate::seeded::exclusive(|| self.build(device))
+    }
+
+    fn build(&self, device: &Device) -> crate::error::Result<Autoencoder> {
+        self.validate()?;
+        let (k, slope) = (self.latent, self.negative_slope);
+        let model = match &self.architecture {
+            Architecture::Convolutional(c) => {
+                Autoencoder::Convolutional(Convolutional::new(k, slope, c, device))
+            }
+            Architecture::Slice(s) => Autoencoder::Slice(SliceNetwork::new(k, slope, s, device)),
+        };
+        // Burn initialises parameters lazily, on first use, from the device's random generator;
+        // drawing them all now, in a fixed order, keeps a seeded run reproducible even when the
+        // first use happens in parallel training shards.
+        let _ = model.clone().into_record();
+        Ok(model)
+    }
 }
 
 impl Autoencoder {
     fn offset_ref(&self) -> Option<&Param<Tensor<3>>> {
         match self {
             Self::Convolutional(c) => c.offset.as_ref(),
-            Self::Spectral(s) => Some(&s.offset),
             Self::Slice(_) => None,
         }
     }
@@ -100,28 +114,8 @@ impl Autoencoder {
                 c.offset = Some(set(old));
                 Ok(Self::Convolutional(c))
             }
-            Self::Spectral(mut s) => {
-                s.offset = set(s.offset);
-                Ok(Self::Spectral(s))
-            }
             Self::Slice(_) => {
                 Err(ModelError::Invalid("the slice network has no per-value offset".into()))
-            }
-        }
-    }
-
-    /// Sets the spectral path's basis: K orthonormal rows of `540 * 90 * 90` values in layout
-    /// order ([`crate::principal::fit_basis`]), moved into the network (1.7 GB for the `cpu`
-    /// preset: not copied).
-    pub fn with_basis(self, rows: Vec<f32>) -> crate::error::Result<Self> {
-        match self {
-            Self::Spectral(mut s) => {
-                let device = s.devices().into_iter().next().unwrap_or_default();
-                s.spectral = s.spectral.with_basis(rows, &device)?;
-                Ok(Self::Spectral(s))
-            }
-            Self::Convolutional(_) | Self::Slice(_) => {
-                Err(ModelError::Invalid("this configuration has no spectral path".into()))
             }
         }
     }
@@ -147,39 +141,10 @@ impl Autoencoder {
         }
     }
 
-    /// The spectral path, if the network is spectral.
-    pub fn spectral(&self) -> Option<&SpectralPath> {
-        match self {
-            Self::Spectral(s) => Some(&s.spectral),
-            Self::Convolutional(_) | Self::Slice(_) => None,
-        }
-    }
-
-    /// The network without its spectral path's basis (see
-    /// [`SpectralPath::without_basis`]); other networks unchanged.
-    pub(crate) fn without_basis(self) -> Self {
-        match self {
-            Self::Spectral(mut s) => {
-                s.spectral = s.spectral.without_basis();
-                Self::Spectral(s)
-            }
-            other => other,
-        }
-    }
-
-    /// The spectral path, mutably (for the codec to take its basis).
-    pub(crate) fn spectral_mut(&mut self) -> Option<&mut SpectralPath> {
-        match self {
-            Self::Spectral(s) => Some(&mut s.spectral),
-            Self::Convolutional(_) | Self::Slice(_) => None,
-        }
-    }
-
     /// The latent dimension k.
     pub fn latent(&self) -> usize {
         match self {
             Self::Convolutional(c) => c.latent,
-            Self::Spectral(s) => s.spectral.latent(),
             Self::Slice(s) => s.latent(),
         }
     }
@@ -207,7 +172,6 @@ impl Autoencoder {
     pub fn encode_centred(&self, centred: Tensor<4>) -> Tensor<2> {
         match self {
             Self::Convolutional(c) => c.encode_centred(centred),
-            Self::Spectral(s) => s.encode_centred(centred),
             Self::Slice(s) => s.encode_centred(centred),
         }
     }
@@ -234,7 +198,6 @@ impl Autoencoder {
     pub fn decode_deviation(&self, latent: Tensor<2>) -> Tensor<4> {
         match self {
             Self::Convolutional(c) => c.decode_deviation(latent),
-            Self::Spectral(s) => s.decode_deviation(latent),
             Self::Slice(s) => s.decode_deviation(latent),
         }
     }

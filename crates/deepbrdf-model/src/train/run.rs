@@ -1,6 +1,12 @@
 //! The training loop every network shares ([`run`]): epochs of seeded batches, the
 //! network-specific step ([`TrainStep`]: loss and gradients of a batch), Adam with the
 //! learning-rate schedule, the NaN stop, checkpoints and exact resume, the CSV log, progress.
+//!
+//! Not Burn's `burn-train` `Learner`: a run here must resume from a checkpoint taken within an
+//! epoch to the same bits (seeded per-epoch orders, the batch position and the optimizer state
+//! saved together), stop on a non-finite loss keeping the last good checkpoint, and let a step
+//! train on what it prepared itself (the slice network's coefficients) rather than on a
+//! dataloader's items; this loop does that in a few hundred lines.
 
 use std::fs;
 use std::path::Path;
@@ -36,13 +42,6 @@ pub trait TrainStep {
     /// matter); by default [`init`](Self::init).
     fn skeleton(&mut self, device: &Device) -> Result<Self::Model> {
         self.init(device)
-    }
-
-    /// What a checkpoint saves of `model`; by default all of it. A step that rebuilds part of
-    /// the network in [`prepare`](Self::prepare) can leave that part out (and out of its
-    /// [`skeleton`](Self::skeleton)).
-    fn checkpointed(&self, model: &Self::Model) -> Self::Model {
-        model.clone()
     }
 
     /// Called once before the first step, with the new (`fresh`) or resumed network: work the
@@ -226,7 +225,7 @@ pub fn run<S: TrainStep>(
             progress.batch_done(indices.len(), &state);
             let epoch_done = state.batch == batches;
             if !epoch_done && last_checkpoint.elapsed().as_secs_f64() >= config.checkpoint_seconds {
-                checkpoint::save(&checkpoint, &step.checkpointed(&model), &optim, &state)?;
+                checkpoint::save(&checkpoint, &model, &optim, &state)?;
                 last_checkpoint = Instant::now();
             }
         }
@@ -242,14 +241,14 @@ pub fn run<S: TrainStep>(
         state.samples = 0;
         state.epoch_seconds = 0.0;
         // Every `checkpoint_seconds` and at the end (epochs of small networks take
-        // milliseconds; a checkpoint of the spectral preset holds a ~1 GB basis).
+        // milliseconds: a checkpoint after each would cost more than the epoch).
         let last = state.epoch == config.epochs;
         let out_of_time = !last && deadline.is_some_and(|d| Instant::now() >= d);
         if last
             || out_of_time
             || last_checkpoint.elapsed().as_secs_f64() >= config.checkpoint_seconds
         {
-            checkpoint::save(&checkpoint, &step.checkpointed(&model), &optim, &state)?;
+            checkpoint::save(&checkpoint, &model, &optim, &state)?;
             last_checkpoint = Instant::now();
         }
         write_log(&dir.join(LOG_FILE), &state.log)?;

@@ -6,8 +6,7 @@
 //! By default held out (issue 13): 5-fold over the materials, each fold's 20 scored by methods
 //! fitted on the other 80, the `slice` preset trained once per fold at k = 10 (five models,
 //! ~2.5 min each on 2 cores; the whole run fits in 30 minutes), image RelAE included. The
-//! paper's in-sample protocol (Fig. 3) is `--mode in-sample`; `--preset cpu --deep-ks all` is
-//! the earlier in-sample run of the README.
+//! paper's in-sample protocol (Fig. 3) is `--mode in-sample`.
 //!
 //! Models are trained into `<out>/models/fold<F>/k<K>` with resume on: rerunning an interrupted
 //! sweep continues where it stopped, and finished models are loaded, not retrained.
@@ -52,8 +51,7 @@ pub struct Args {
     #[arg(long, value_name = "LIST")]
     pub deep_ks: Option<String>,
     /// Network and training preset: `slice` (one network shared by the phi_d slices, the
-    /// shipped model's), `cpu` (spectral coordinates of the whole table) or `paper` (Table 1
-    /// and §3.2's training, for a GPU).
+    /// shipped model's) or `paper` (Table 1 and §3.2's training, for a GPU).
     #[arg(long, default_value = "slice")]
     pub preset: Preset,
     #[command(flatten)]

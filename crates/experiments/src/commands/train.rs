@@ -21,8 +21,8 @@ pub struct Args {
     #[arg(long)]
     pub k: Option<usize>,
     /// slice (the shipped model's network: one basis for all phi_d slices and a shared MLP
-    /// decoder, sized for a 2-core CPU), paper (Table 1, lr 2e-5, batch 32, 1000 epochs: for
-    /// GPUs) or cpu (the earlier spectral network, superseded by slice).
+    /// decoder, sized for a 2-core CPU) or paper (Table 1, lr 2e-5, batch 32, 1000 epochs:
+    /// for GPUs).
     #[arg(long, default_value = "slice", value_parser = parse_preset)]
     pub preset: Preset,
     /// A training configuration (JSON, as saved in DIR/train_config.json) instead of a preset.

@@ -1,6 +1,6 @@
 //! One batch of the autoencoder's training data, prepared on the CPU: inputs and targets
-//! centred on the fixed offset and masked, slice dropout (§3.2, Fig. 2) drawn per (seed, epoch,
-//! BRDF), and the spectral coordinates of the filled inputs for training on coordinates.
+//! centred on the fixed offset and masked, and slice dropout (§3.2, Fig. 2) drawn per (seed,
+//! epoch, BRDF), shared by the network families' training steps.
 
 use burn::prelude::*;
 use burn::tensor::TensorData;
@@ -9,9 +9,29 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use crate::autoencoder::{Autoencoder, INPUT_CHANNELS, INPUT_SIDE, INPUT_VALUES};
-use crate::error::ModelError;
 use crate::training_set::TrainingSet;
+use deepbrdf_data::layout::{
+    LAYOUT_VALUES as INPUT_VALUES, SIDE as INPUT_SIDE, SLICE_CHANNELS as INPUT_CHANNELS,
+};
+
+/// Slice dropout of a run: its probability, its parsed selections and the run's seed.
+pub(crate) struct SliceDropout {
+    pub probability: f64,
+    pub selections: Vec<SliceSelection>,
+    pub seed: u64,
+}
+
+impl SliceDropout {
+    /// The dropout of epoch `epoch` (0-based).
+    pub(crate) fn at_epoch(&self, epoch: usize) -> Augment<'_> {
+        Augment {
+            probability: self.probability,
+            selections: &self.selections,
+            seed: self.seed,
+            epoch,
+        }
+    }
+}
 
 /// Slice dropout applied to one batch.
 pub(crate) struct Augment<'a> {
@@ -58,40 +78,6 @@ pub(crate) struct Batch {
     pub mask: Tensor<4>,
     /// Valid values of each BRDF.
     pub valid: Vec<f64>,
-}
-
-/// The spectral coordinates of every BRDF of `data` with only the slices of each selection
-/// (the missing ones filled from their nearest kept one), `[brdf][selection][K]`; the kept
-/// slices of a random selection are drawn once per (seed, BRDF, selection).
-pub(crate) fn filled_coefficients(
-    model: &Autoencoder,
-    data: &TrainingSet,
-    offset: &[f32],
-    selections: &[SliceSelection],
-    seed: u64,
-) -> crate::error::Result<Vec<Vec<Vec<f32>>>> {
-    let model = model.valid();
-    let path = model
-        .spectral()
-        .ok_or_else(|| ModelError::Invalid("coefficient training needs a spectral path".into()))?;
-    let device = model.devices().into_iter().next().unwrap_or_default();
-    let mut out = vec![Vec::with_capacity(selections.len()); data.len()];
-    for (i, slot) in out.iter_mut().enumerate() {
-        let mut rows = vec![0f32; selections.len() * INPUT_VALUES];
-        for (s, selection) in selections.iter().enumerate() {
-            let filled = filled_input(data, i, s, selection, seed);
-            let row = &mut rows[s * INPUT_VALUES..(s + 1) * INPUT_VALUES];
-            centre(row, &filled, data.mask(i), Some(offset));
-        }
-        let rows = Tensor::<2>::from_data(
-            TensorData::new(rows, [selections.len(), INPUT_VALUES]),
-            &device,
-        );
-        let c: Vec<f32> =
-            crate::read_back::values(path.coefficients(rows), "the batch's coefficients")?;
-        *slot = c.chunks(path.size()).map(<[f32]>::to_vec).collect();
-    }
-    Ok(out)
 }
 
 /// BRDF `i` of `data` with only the slices of `selection` (number `s` of the run's selections),

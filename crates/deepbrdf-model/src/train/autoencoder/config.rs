@@ -9,8 +9,9 @@ use burn::optim::AdamConfig;
 use burn::prelude::*;
 use deepbrdf_data::augment::SliceSelection;
 
+use super::batch::SliceDropout;
 use crate::atomic::read_limited;
-use crate::autoencoder::AutoencoderConfig;
+use crate::autoencoder::{Autoencoder, AutoencoderConfig};
 use crate::error::ModelError;
 use crate::train::checkpoint::{self, CHECKPOINT_FILE};
 use crate::train::config::{adam, LoopConfig};
@@ -96,25 +97,12 @@ impl TrainConfig {
         Self::new(AutoencoderConfig::paper(k), adam())
     }
 
-    /// The CPU preset: the spectral network of [`AutoencoderConfig::cpu`], Adam 1e-3 with
-    /// cosine decay to 5e-5, batches of 8, 1000 epochs as the paper, slice dropout (half the
-    /// inputs shown with 1/3 or 1/9 of the slices, §3.2) (about 15 s for 100 BRDFs on two
-    /// cores, plus ~20 s for the basis fit and the projection of the filled inputs).
-    pub fn cpu(k: usize) -> Self {
-        Self::new(AutoencoderConfig::cpu(k), adam())
-            .with_learning_rate(1e-3)
-            .with_final_lr_factor(0.05)
-            .with_epochs(1000)
-            .with_batch_size(8)
-            .with_threads(1)
-            .with_slice_dropout(Some(SliceDropoutConfig::new()))
-    }
-
     /// The `slice` preset, the shipped default model's: the network of
     /// [`AutoencoderConfig::slice`] (one basis for all phi_d slices, a decoder MLP shared by
     /// them, channel permutations and mixtures as extra training BRDFs), Adam 1e-3 with cosine
-    /// decay to 5e-5, batches of 32, slice dropout as the `cpu` preset. Bounded to a few
-    /// minutes on two cores for 100 BRDFs (the README has the measured times).
+    /// decay to 5e-5, batches of 32, slice dropout (half the inputs shown with 1/3 or 1/9 of
+    /// the slices, §3.2). Bounded to a few minutes on two cores for 100 BRDFs
+    /// (docs/model.md has the measured times).
     pub fn slice(k: usize) -> Self {
         Self::new(AutoencoderConfig::slice(k), adam())
             .with_learning_rate(1e-3)
@@ -161,6 +149,25 @@ impl TrainConfig {
             dropout.parsed()?;
         }
         Ok(())
+    }
+
+    /// Slice dropout's probability and parsed selections with the run's seed, if it is on.
+    pub(crate) fn dropout(&self) -> crate::error::Result<Option<SliceDropout>> {
+        match &self.slice_dropout {
+            Some(d) => Ok(Some(SliceDropout {
+                probability: d.probability,
+                selections: d.parsed()?,
+                seed: self.seed,
+            })),
+            None => Ok(None),
+        }
+    }
+
+    /// The network of a new run, its weights drawn from the run's seed. Seeded even when
+    /// resuming: an unseeded draw from the shared generator could fall between the seeding
+    /// and the draws of another run's initialisation.
+    pub(crate) fn init_network(&self, device: &Device) -> crate::error::Result<Autoencoder> {
+        self.model.init_seeded(self.seed, device)
     }
 
     /// The learning rate of step `step` of `total` ([`LoopConfig::learning_rate_at`]).

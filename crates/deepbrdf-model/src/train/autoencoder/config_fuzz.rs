@@ -15,7 +15,7 @@ use super::TrainConfig;
 
 #[test]
 fn mutated_training_configurations_are_refused_or_read_never_a_panic() {
-    let corpus: Vec<Vec<u8>> = [TrainConfig::cpu(10), TrainConfig::paper(5)]
+    let corpus: Vec<Vec<u8>> = [TrainConfig::slice(10), TrainConfig::paper(5)]
         .iter()
         .map(|c| config_to_json(c).into_bytes())
         .collect();

@@ -2,10 +2,8 @@
 //! the masked L2 loss of eq. (4), seeded shuffling, slice dropout, checkpoints that resume
 //! exactly, and the final per-BRDF evaluation.
 
-mod batch;
-mod config;
-mod slice_step;
-mod step;
+pub(crate) mod batch;
+pub(crate) mod config;
 
 use std::path::Path;
 use std::time::Duration;
@@ -14,9 +12,12 @@ use burn::prelude::*;
 use deepbrdf_data::Progress;
 
 pub use config::{saved_config, SliceDropoutConfig, TrainConfig};
-pub(crate) use step::{coefficient_gradients, gradients};
 
-use crate::autoencoder::{legacy, Autoencoder, INPUT_VALUES};
+use crate::autoencoder::convolutional::step::ConvolutionalStep;
+use crate::autoencoder::slice::step::SliceStep;
+use crate::autoencoder::{
+    retired_message, retired_network, Architecture, Autoencoder, INPUT_VALUES,
+};
 use crate::error::ModelError;
 use crate::train::checkpoint::{self, checkpoint_path};
 use crate::train::log::EpochRecord;
@@ -24,7 +25,6 @@ use crate::train::run::{run, Session};
 use crate::training_set::TrainingSet;
 use batch::batch_tensors;
 use deepbrdf_data::layout::PLANE;
-use step::AutoencoderStep;
 
 /// A trained network and how it was trained.
 #[derive(Debug)]
@@ -107,20 +107,24 @@ fn train_in(
     let path = checkpoint_path(session.dir());
     if path.exists() && session.resumes() {
         let saved = checkpoint::saved_state(&path)?;
-        if saved.config.get("model").is_some_and(legacy::is_legacy) {
-            return Err(ModelError::format(
-                &path,
-                "this checkpoint was written by an earlier version of deepbrdf (before the \
-                 network architectures became variants) and cannot be resumed; a finished run's \
-                 model/ still loads; to train again, start a new run in another directory",
-            ));
+        if let Some(what) = saved.config.get("model").and_then(retired_network) {
+            return Err(ModelError::format(&path, retired_message(what)));
         }
     }
     let fingerprint = data.fingerprint();
-    let mut step = AutoencoderStep::new(config, data)?;
-    let samples = step.samples();
-    let outcome =
-        run(&config.loop_config(), &identity, &fingerprint, samples, &mut step, session, device)?;
+    let settings = config.loop_config();
+    // Each network family brings its own step to the one loop.
+    let outcome = match &config.model.architecture {
+        Architecture::Convolutional(_) => {
+            let mut step = ConvolutionalStep::new(config, data)?;
+            run(&settings, &identity, &fingerprint, data.len(), &mut step, session, device)?
+        }
+        Architecture::Slice(layers) => {
+            let mut step = SliceStep::new(config, layers, data)?;
+            let samples = step.samples();
+            run(&settings, &identity, &fingerprint, samples, &mut step, session, device)?
+        }
+    };
     let model = outcome.model.valid();
     let per_material_mse = evaluate(&model, data, config.batch_size, session.progress())?;
     Ok(Trained {

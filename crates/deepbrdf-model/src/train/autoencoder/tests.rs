@@ -1,6 +1,6 @@
-//! Tests of the autoencoder's training: the loss falls on every CPU backend, training on
-//! coordinates equals the full eq. (4), exact resume (with and without slice dropout), bad
-//! checkpoints and configuration files, divergence, thread-count independence.
+//! Tests of the autoencoder's training: the loss falls on every CPU backend, training a slice
+//! network on coefficients equals the full eq. (4), exact resume (with and without slice
+//! dropout), bad checkpoints and configuration files, divergence, thread-count independence.
 
 use burn::optim::AdamConfig;
 use deepbrdf_data::augment::SliceSelection;
@@ -75,16 +75,6 @@ fn mixed_set() -> TrainingSet {
     TrainingSet::from_layouts("mixed", names, inputs, vec![mask; 4]).unwrap()
 }
 
-fn spectral_config(epochs: usize) -> TrainConfig {
-    TrainConfig::new(AutoencoderConfig::spectral(1, 3, Some(16)), adam())
-        .with_learning_rate(2e-2)
-        .with_final_lr_factor(0.01)
-        .with_epochs(epochs)
-        .with_batch_size(4)
-        .with_seed(3)
-        .with_checkpoint_seconds(1e6) // at the end only: each holds the 52 MB basis
-}
-
 fn device() -> Device {
     DeviceKind::default_kind().unwrap().device().unwrap()
 }
@@ -116,27 +106,6 @@ fn the_loss_falls_on_every_compiled_backend() {
 }
 
 #[test]
-fn spectral_training_on_coordinates_matches_the_full_loss() {
-    // The coordinate loss (plus the distance to the basis' span) is eq. (4) on the full
-    // tensors: after training, the logged loss of the last epoch (the model barely moves at
-    // the end of the cosine decay) agrees with a full-space evaluation of the trained model.
-    let set = mixed_set();
-    let config = spectral_config(500);
-    let dir = tempfile::tempdir().unwrap();
-    let trained = train(&config, &set, dir.path(), false, &Silent, &device()).unwrap();
-    let (first, last) = (trained.log[0].loss, trained.log.last().unwrap().loss);
-    assert!(last < 0.7 * first, "loss {first} -> {last}");
-    let full = trained.mean_mse();
-    assert!((full - last).abs() <= 1e-2 * full, "coordinates {last} vs full {full}");
-    // With slice dropout (on the coordinates of filled inputs) training still fits.
-    let dropout = config.clone().with_slice_dropout(Some(SliceDropoutConfig::new()));
-    let other = tempfile::tempdir().unwrap();
-    let augmented = train(&dropout, &set, other.path(), false, &Silent, &device()).unwrap();
-    assert!(augmented.log.last().unwrap().loss < 0.9 * augmented.log[0].loss);
-    assert_ne!(losses(&augmented), losses(&trained), "dropout changes what is trained on");
-}
-
-#[test]
 fn a_killed_run_resumes_to_the_same_result() {
     // 2 batches per epoch, the last one short. One shard per batch.
     let set = tiny_set(3);
@@ -164,18 +133,15 @@ fn a_killed_run_resumes_to_the_same_result() {
 }
 
 #[test]
-fn a_killed_spectral_run_with_slice_dropout_resumes_to_the_same_result() {
-    // The cpu preset's kind of run: coordinates, slice dropout drawn per (seed, epoch, BRDF)
+fn a_killed_slice_run_with_slice_dropout_resumes_to_the_same_result() {
+    // The slice preset's kind of run: coefficients, slice dropout drawn per (seed, epoch, BRDF)
     // with probability 1/2. Batches of 2: killed after the first batch of epoch 3, with a
     // checkpoint after every batch; the resumed run must draw the same dropout and reach the
     // same weights as the straight one.
     let set = mixed_set();
     let dropout =
         SliceDropoutConfig::new().with_selections(vec!["every:3".into(), "random:20".into()]);
-    let config = spectral_config(4)
-        .with_batch_size(2)
-        .with_checkpoint_seconds(0.0)
-        .with_slice_dropout(Some(dropout));
+    let config = slice_config(4).with_slice_dropout(Some(dropout));
     let straight_dir = tempfile::tempdir().unwrap();
     let straight = train(&config, &set, straight_dir.path(), false, &Silent, &device()).unwrap();
     let without = config.clone().with_slice_dropout(None);
@@ -194,10 +160,10 @@ fn a_killed_spectral_run_with_slice_dropout_resumes_to_the_same_result() {
 }
 
 #[test]
-fn the_thread_count_does_not_change_a_spectral_run() {
-    // Rayon's pool size must not enter any sum (basis fit, centring, evaluation).
+fn the_thread_count_does_not_change_a_slice_run() {
+    // Rayon's pool size must not enter any sum (basis fit, projections, evaluation).
     let set = mixed_set();
-    let config = spectral_config(20).with_slice_dropout(Some(SliceDropoutConfig::new()));
+    let config = slice_config(20).with_slice_dropout(Some(SliceDropoutConfig::new()));
     let in_pool = |threads: usize| {
         let dir = tempfile::tempdir().unwrap();
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
@@ -226,14 +192,20 @@ fn a_damaged_checkpoint_is_reported_not_used() {
 fn a_bad_configuration_file_is_named_with_its_problem() {
     let dir = tempfile::tempdir().unwrap();
     let good = dir.path().join("good.json");
-    std::fs::write(&good, TrainConfig::cpu(5).with_epochs(3).to_string()).unwrap();
+    std::fs::write(&good, TrainConfig::slice(5).with_epochs(3).to_string()).unwrap();
     let read = TrainConfig::from_file(&good).unwrap();
-    assert_eq!(read.to_string(), TrainConfig::cpu(5).with_epochs(3).to_string());
+    assert_eq!(read.to_string(), TrainConfig::slice(5).with_epochs(3).to_string());
+    let slice = TrainConfig::slice(5).to_string();
     let cases = [
-        ("truncated.json", TrainConfig::cpu(5).to_string()[..40].to_string(), "EOF"),
-        ("typo.json", TrainConfig::cpu(5).to_string().replace("\"epochs\"", "\"epocs\""), "epochs"),
-        ("zero.json", TrainConfig::cpu(5).with_batch_size(0).to_string(), "batches of 0"),
-        ("k.json", TrainConfig::cpu(97).to_string(), "96 directions for k = 97"),
+        ("truncated.json", slice[..40].to_string(), "EOF"),
+        ("typo.json", slice.replace("\"epochs\"", "\"epocs\""), "epochs"),
+        ("zero.json", TrainConfig::slice(5).with_batch_size(0).to_string(), "batches of 0"),
+        (
+            "k.json",
+            slice.replace("\"components\": 40", "\"components\": 3"),
+            "3 principal components for k = 5",
+        ),
+        ("retired.json", retired_cpu_config(), "retired"),
         ("text.json", "epochs = 3".to_string(), "not a training configuration"),
     ];
     for (name, text, problem) in cases {
@@ -400,4 +372,14 @@ fn the_image_space_weighting_favours_the_dark_material() {
         weighted[0] / weighted[1] < plain[0] / plain[1],
         "dark/bright: {weighted:?} weighted vs {plain:?} plain"
     );
+}
+
+/// The training configuration of the retired `cpu` preset as earlier versions wrote it (the
+/// spectral network at k = 5).
+fn retired_cpu_config() -> String {
+    let mut value: serde_json::Value =
+        serde_json::from_str(&TrainConfig::slice(5).to_string()).unwrap();
+    value["model"]["architecture"] =
+        serde_json::json!({"spectral": {"directions": 96, "hidden": 256, "he_init": true}});
+    value.to_string()
 }

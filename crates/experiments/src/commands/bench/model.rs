@@ -11,7 +11,7 @@ use deepbrdf_model::{Preset, TrainConfig};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Which presets to time: cpu, paper, or both (default).
+    /// Which preset to time: paper or slice (default: both).
     #[arg(long, value_name = "NAME", value_parser = parse_preset)]
     pub preset: Option<Preset>,
     /// Latent dimension k.
@@ -72,16 +72,6 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
             net.median(),
             all.median()
         );
-        if let Some(f32_net) = &decode.f32_network {
-            println!(
-                "{:7} spectral basis: compact f16 codec {:.4} s vs f32 network {:.4} s to the \
-                 mapped layout ({:.2}x faster, same run)",
-                "",
-                net.median(),
-                f32_net.median(),
-                f32_net.median() / net.median()
-            );
-        }
         println!(
             "{:7} decode vs IPCA's at k = {}: {:.4} s vs {:.4} s ({:.2}x, same run)",
             "",

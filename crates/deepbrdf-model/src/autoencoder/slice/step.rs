@@ -1,12 +1,10 @@
-//! The `slice` network's side of the autoencoder's training step
-//! ([`crate::autoencoder::slice_network`]): the fits of its fixed parts (slice basis, mean and
-//! principal components of the coefficients of the training BRDFs and their augmentations) and
-//! the eq. (4) loss of a batch on coefficients.
+//! The `slice` network's training step ([`TrainStep`], [`super::network`]): the fits of its
+//! fixed parts (slice basis, mean and principal components of the coefficients of the training
+//! BRDFs and their augmentations) and the eq. (4) loss of a batch on coefficients.
 //!
 //! For an orthonormal slice basis B, the squared error of an output `B^T a_hat` against a
 //! training layout x is `|a_hat - B x|^2` plus the (fixed) squared distance of x to B's span:
-//! training runs on the 540 x M coefficients of each BRDF, computed once, as the `cpu` preset's
-//! runs on its coordinates. (The output is compared on every cell of each image; the masked
+//! training runs on the 540 x M coefficients of each BRDF, computed once. (The output is compared on every cell of each image; the masked
 //! loss of eq. (4) skips the cells invalid in that slice, where the target's projection is
 //! near 0: the coefficient loss bounds it from above.)
 
@@ -16,20 +14,99 @@ use burn::tensor::TensorData;
 use deepbrdf_data::augment::SliceSelection;
 use deepbrdf_data::Progress;
 
-use super::batch::{centre, filled_input};
-use crate::augmentation::sample_layout;
-use crate::autoencoder::{Autoencoder, SliceConfig, INPUT_VALUES};
+use deepbrdf_data::layout::LAYOUT_VALUES;
+
+use super::augmentation::sample_layout;
+use super::basis::{basis_t, fit_components, fit_slice_basis, project};
+use super::config::SliceConfig;
+use crate::autoencoder::Autoencoder;
 use crate::error::ModelError;
 use crate::loss::colour_weights;
-use crate::slice_basis::{basis_t, fit_components, fit_slice_basis, project};
-use crate::train::run::on_device;
+use crate::train::autoencoder::batch::{centre, filled_input, SliceDropout};
+use crate::train::autoencoder::config::TrainConfig;
+use crate::train::run::{on_device, TrainStep};
 use crate::training_set::TrainingSet;
 
 /// Samples projected with one product.
 const PROJECTED_AT_ONCE: usize = 8;
 
+/// The slice network of `config` (its settings `layers`) trained on `data` and the
+/// augmentations of it.
+pub(crate) struct SliceStep<'a> {
+    config: &'a TrainConfig,
+    layers: &'a SliceConfig,
+    data: &'a TrainingSet,
+    dropout: Option<SliceDropout>,
+    /// The coefficients of the training samples, once [`prepare`](TrainStep::prepare)d.
+    fit: Option<SliceFit>,
+}
+
+impl<'a> SliceStep<'a> {
+    pub(crate) fn new(
+        config: &'a TrainConfig,
+        layers: &'a SliceConfig,
+        data: &'a TrainingSet,
+    ) -> crate::error::Result<Self> {
+        Ok(Self { config, layers, data, dropout: config.dropout()?, fit: None })
+    }
+
+    /// The number of training samples: the BRDFs and their augmentations.
+    pub(crate) fn samples(&self) -> usize {
+        self.layers.augmentation.samples(self.data.len())
+    }
+}
+
+impl TrainStep for SliceStep<'_> {
+    type Model = Autoencoder;
+
+    fn init(&mut self, device: &Device) -> crate::error::Result<Autoencoder> {
+        self.config.init_network(device)
+    }
+
+    /// Fits the network's fixed parts to the training set (again on resume: the fits are
+    /// deterministic).
+    fn prepare(
+        &mut self,
+        model: Autoencoder,
+        fresh: bool,
+        progress: &dyn Progress,
+    ) -> crate::error::Result<Autoencoder> {
+        let selections = self.dropout.as_ref().map(|d| d.selections.as_slice());
+        let (model, fit) =
+            prepare(model, self.data, self.layers, selections, self.config.seed, fresh, progress)?;
+        self.fit = Some(fit);
+        Ok(model)
+    }
+
+    fn step(
+        &mut self,
+        model: &Autoencoder,
+        epoch: usize,
+        indices: &[usize],
+        device: &Device,
+    ) -> crate::error::Result<(f32, MultiGradientsParams)> {
+        let fit = self
+            .fit
+            .as_ref()
+            .ok_or_else(|| ModelError::Invalid("a slice step before its fit".into()))?;
+        let augment = self.dropout.as_ref().map(|d| d.at_epoch(epoch));
+        let n = self.data.len();
+        let inputs: Vec<f32> = indices
+            .iter()
+            .flat_map(|&i| {
+                let choice = augment.as_ref().filter(|_| i < n).and_then(|a| a.choice(i));
+                match (&fit.filled, choice) {
+                    (Some(filled), Some(s)) => filled[i][s].clone(),
+                    _ => fit.target(i).to_vec(),
+                }
+            })
+            .collect();
+        slice_gradients(model, fit, indices, inputs, device)
+    }
+}
+
 /// The coefficients of every training sample (the BRDFs, then their augmentations).
-pub(crate) struct SliceFit {
+struct SliceFit {
     /// `[sample][540 * M]`: the targets.
     targets: Vec<Vec<f32>>,
     /// Squared distance of each sample's layout to the slice basis' span.
@@ -41,12 +118,12 @@ pub(crate) struct SliceFit {
     weights: Option<Vec<[f32; 3]>>,
     /// With slice dropout: the coefficients of the filled inputs of the BRDFs (not of the
     /// augmentations), `[brdf][selection][540 * M]`.
-    pub(crate) filled: Option<Vec<Vec<Vec<f32>>>>,
+    filled: Option<Vec<Vec<Vec<f32>>>>,
 }
 
 impl SliceFit {
     /// The target coefficients of sample `i`.
-    pub(crate) fn target(&self, i: usize) -> &[f32] {
+    fn target(&self, i: usize) -> &[f32] {
         &self.targets[i]
     }
 }
@@ -54,7 +131,7 @@ impl SliceFit {
 /// Fits the slice basis to `data`, projects its BRDFs and their augmentations, fits the mean
 /// and principal components of the coefficients and sets all three in `model` when `fresh`
 /// (a resumed network has them from its checkpoint; the fits are deterministic).
-pub(crate) fn prepare(
+fn prepare(
     model: Autoencoder,
     data: &TrainingSet,
     layers: &SliceConfig,
@@ -126,7 +203,7 @@ pub(crate) fn prepare(
     let filled = match selections {
         Some(selections) => {
             progress.status("projecting the slice-dropout inputs");
-            let mut row = vec![0f32; INPUT_VALUES];
+            let mut row = vec![0f32; LAYOUT_VALUES];
             let filled = (0..n)
                 .map(|i| {
                     selections
@@ -159,7 +236,7 @@ fn normalised(weights: Vec<[f64; 3]>) -> Vec<[f32; 3]> {
 /// channel's times its weight, plus their residuals, over their valid values) and its
 /// gradients; `inputs` are the encoder's input coefficients, the targets' or those of filled
 /// inputs.
-pub(crate) fn slice_gradients(
+fn slice_gradients(
     model: &Autoencoder,
     fit: &SliceFit,
     indices: &[usize],

@@ -1,6 +1,6 @@
-//! The `slice` preset's network (issue 13; not Table 1, but the paper's premise of one network
-//! shared across phi_d slices, sized to ship): every one of the 540 (theta_h, theta_d) images of
-//! the §3.2 layout is written in one shared basis of M directions ([`crate::slice_basis`]), and
+//! The `slice` preset's network (not Table 1, but the paper's premise of one network shared
+//! across phi_d slices, sized to ship): every one of the 540 (theta_h, theta_d) images of the
+//! §3.2 layout is written in one shared basis of M directions ([`super::basis`]), and
 //!
 //! - encoder f (eq. 2): `a = B x` per image (540 x M coefficients), `c = P (a - m)` (the K
 //!   leading principal components of the coefficient vectors), `z = c[..k] + f_mlp(c)`;
@@ -10,21 +10,21 @@
 //!   image is `B^T` of them.
 //!
 //! Both MLPs' last layers start at zero: an untrained network is PCA in the mapped space within
-//! the slice basis' span. B (M x 8100), m and P (K x 540 M) are fixed, fitted before training;
-//! with M = 64 and K = 40 the whole network is ~2.6 M values (10 MB), against 420 M for the
-//! `cpu` preset's basis. There is no per-value offset: B spans the mean shape (it is fitted to
-//! uncentred images), m holds it.
+//! the slice basis' span. B (M x 8100), m and P (K x 540 M) are fixed, fitted before training
+//! (docs/model.md gives the preset's size). There is no per-value offset: B spans the mean
+//! shape (it is fitted to uncentred images), m holds it.
 
 use burn::module::Param;
 use burn::nn::Linear;
 use burn::prelude::*;
 use burn::tensor::TensorData;
 
-use super::config::{AutoencoderConfig, SliceConfig};
-use super::{INPUT_CHANNELS, INPUT_SIDE};
+use deepbrdf_data::layout::{PLANE, SIDE as INPUT_SIDE, SLICE_CHANNELS as INPUT_CHANNELS};
+
+use super::config::SliceConfig;
+use super::mlp::{mlp_forward, mlp_layers};
+use crate::autoencoder::init::initializers;
 use crate::error::ModelError;
-use crate::slice_basis::SLICE_VALUES;
-use crate::spectral::{mlp_forward, mlp_layers};
 use deepbrdf_data::merl::N_PHI_D;
 
 /// Colour channels of one phi_d slice.
@@ -55,15 +55,21 @@ fn fixed<const D: usize>(shape: [usize; D], device: &Device) -> Param<Tensor<D>>
 }
 
 impl SliceNetwork {
-    /// The network of `layers` for `config`'s k and slope; fixed parts at zero until
-    /// [`with_fit`](Self::with_fit), the MLPs' last layers at zero.
-    pub(super) fn new(config: &AutoencoderConfig, layers: &SliceConfig, device: &Device) -> Self {
-        let (hidden_init, _) = config.initializers(true);
+    /// The network of `layers` for latent dimension `latent` and leaky ReLU slope
+    /// `negative_slope`; fixed parts at zero until [`with_fit`](Self::with_fit), the MLPs'
+    /// last layers at zero.
+    pub(crate) fn new(
+        latent: usize,
+        negative_slope: f64,
+        layers: &SliceConfig,
+        device: &Device,
+    ) -> Self {
+        let (hidden_init, _) = initializers(true, negative_slope);
         let mlp =
             |from: usize, to: usize| mlp_layers(from, layers.hidden, to, &hidden_init, device);
-        let (m, size, k) = (layers.directions, layers.components, config.latent);
+        let (m, size, k) = (layers.directions, layers.components, latent);
         Self {
-            basis: fixed([m, SLICE_VALUES], device),
+            basis: fixed([m, PLANE], device),
             mean: fixed([INPUT_CHANNELS * m], device),
             components: fixed([size, INPUT_CHANNELS * m], device),
             encoder: mlp(size, k),
@@ -72,7 +78,7 @@ impl SliceNetwork {
             size,
             latent: k,
             harmonics: layers.harmonics,
-            negative_slope: config.negative_slope,
+            negative_slope,
         }
     }
 
@@ -101,7 +107,7 @@ impl SliceNetwork {
     ) -> crate::error::Result<Self> {
         let len = self.coefficient_len();
         let sizes = [
-            ("slice basis", basis.len(), self.directions * SLICE_VALUES),
+            ("slice basis", basis.len(), self.directions * PLANE),
             ("mean coefficients", mean.len(), len),
             ("principal components", components.len(), self.size * len),
         ];
@@ -119,7 +125,7 @@ impl SliceNetwork {
             let data = TensorData::new(values.to_vec(), shape);
             old.map(|old| Tensor::from_data(data, &old.device())).set_require_grad(false)
         };
-        self.basis = set2(self.basis, basis, [self.directions, SLICE_VALUES]);
+        self.basis = set2(self.basis, basis, [self.directions, PLANE]);
         self.components = set2(self.components, components, [self.size, len]);
         let data = TensorData::new(mean.to_vec(), [len]);
         self.mean =
@@ -137,7 +143,7 @@ impl SliceNetwork {
     /// - masked: `[batch, 540, 90, 90]` -> `[batch, 540 * M]`
     pub fn coefficients(&self, masked: Tensor<4>) -> Tensor<2> {
         let batch = masked.dims()[0];
-        let images = masked.reshape([batch * INPUT_CHANNELS, SLICE_VALUES]); // [batch*540, 8100]
+        let images = masked.reshape([batch * INPUT_CHANNELS, PLANE]); // [batch*540, 8100]
         let a = images.matmul(self.basis.val().transpose()); // [batch*540, M]
         a.reshape([batch, self.coefficient_len()])
     }
@@ -236,7 +242,7 @@ impl SliceNetwork {
     ///
     /// # Shapes
     /// - masked: `[batch, 540, 90, 90]` -> `[batch, k]`
-    pub(super) fn encode_centred(&self, masked: Tensor<4>) -> Tensor<2> {
+    pub(crate) fn encode_centred(&self, masked: Tensor<4>) -> Tensor<2> {
         self.encode_coefficients(self.coefficients(masked))
     }
 
@@ -244,7 +250,7 @@ impl SliceNetwork {
     ///
     /// # Shapes
     /// - latent: `[batch, k]` -> `[batch, 540, 90, 90]`
-    pub(super) fn decode_deviation(&self, latent: Tensor<2>) -> Tensor<4> {
+    pub(crate) fn decode_deviation(&self, latent: Tensor<2>) -> Tensor<4> {
         self.expand(self.decode_coefficients(latent))
     }
 }

@@ -1,4 +1,4 @@
-//! Training-set augmentation in linear BRDF space (not in the paper; issue 13): extra training
+//! Training-set augmentation in linear BRDF space (not in the paper): extra training
 //! BRDFs made from the mapped layouts of a [`TrainingSet`] through the inverse of eq. (1) and
 //! back, with the set's reference.
 //!
@@ -20,17 +20,15 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::autoencoder::INPUT_VALUES;
 use crate::error::ModelError;
 use crate::training_set::TrainingSet;
+use deepbrdf_data::layout::{LAYOUT_VALUES, PLANE};
 use deepbrdf_data::mapping::{inverse_log_relative, log_relative};
 use deepbrdf_data::merl::N_PHI_D;
 
 /// The orders of the three colour channels; the first is the identity.
 const PERMUTATIONS: [[usize; 3]; 6] =
     [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
-/// Values of one colour image of the layout.
-const IMAGE: usize = INPUT_VALUES / (3 * N_PHI_D);
 /// The quantile of a channel's valid linear values taken as its diffuse floor.
 pub const FLOOR_QUANTILE: f64 = 0.1;
 /// The range of a floor's scale `s` (drawn log-uniformly).
@@ -191,7 +189,7 @@ pub fn sample_layout(data: &TrainingSet, sample: Sample) -> crate::error::Result
             data.label()
         ))
     })?;
-    let mut out = vec![0f32; INPUT_VALUES];
+    let mut out = vec![0f32; LAYOUT_VALUES];
     let unmap = |x: f32, r: f32| inverse_log_relative(f64::from(x), f64::from(r));
     let map = |rho: f64, r: f32| {
         log_relative(rho.max(-deepbrdf_data::mapping::EPSILON), f64::from(r)) as f32
@@ -207,10 +205,10 @@ pub fn sample_layout(data: &TrainingSet, sample: Sample) -> crate::error::Result
                 }
                 _ => [0.0; 3],
             };
-            out.par_chunks_mut(IMAGE).enumerate().for_each(|(image, o)| {
+            out.par_chunks_mut(PLANE).enumerate().for_each(|(image, o)| {
                 let (slice, colour) = (image / 3, image % 3);
-                let from = (slice * 3 + perm[colour]) * IMAGE;
-                let to = image * IMAGE;
+                let from = (slice * 3 + perm[colour]) * PLANE;
+                let to = image * PLANE;
                 let lowered = floors[perm[colour]];
                 for (c, v) in o.iter_mut().enumerate() {
                     if mask[to + c] != 0.0 {
@@ -225,8 +223,8 @@ pub fn sample_layout(data: &TrainingSet, sample: Sample) -> crate::error::Result
         Sample::Mixture { a, b, t } => {
             let (xa, xb) = (data.input(a), data.input(b));
             let (ma, mb) = (data.mask(a), data.mask(b));
-            out.par_chunks_mut(IMAGE).enumerate().for_each(|(image, o)| {
-                let start = image * IMAGE;
+            out.par_chunks_mut(PLANE).enumerate().for_each(|(image, o)| {
+                let start = image * PLANE;
                 for (c, v) in o.iter_mut().enumerate() {
                     let i = start + c;
                     if ma[i] != 0.0 && mb[i] != 0.0 {
@@ -248,8 +246,8 @@ fn diffuse_floors(data: &TrainingSet, index: usize, reference: &[f32]) -> [f64; 
     std::array::from_fn(|colour| {
         let mut values: Vec<f64> = (0..N_PHI_D)
             .flat_map(|slice| {
-                let start = (slice * 3 + colour) * IMAGE;
-                (start..start + IMAGE).filter(|&i| mask[i] != 0.0)
+                let start = (slice * 3 + colour) * PLANE;
+                (start..start + PLANE).filter(|&i| mask[i] != 0.0)
             })
             .map(|i| inverse_log_relative(f64::from(x[i]), f64::from(reference[i])).max(0.0))
             .collect();
@@ -301,19 +299,19 @@ mod tests {
         let linear =
             |x: &[f32], i: usize| inverse_log_relative(f64::from(x[i]), f64::from(reference[i]));
         // Slice 7, a valid cell of image (7, colour): red and blue swapped (order [2, 1, 0]).
-        let cell = (0..IMAGE).find(|&c| data.mask(0)[(7 * 3) * IMAGE + c] != 0.0).unwrap();
+        let cell = (0..PLANE).find(|&c| data.mask(0)[(7 * 3) * PLANE + c] != 0.0).unwrap();
         let (swapped, valid) =
             sample_layout(&data, Sample::Permuted { index: 0, order: 5 }).unwrap();
         assert_eq!(valid, data.valid_values(0));
-        let red = 7 * 3 * IMAGE + cell;
-        let blue = (7 * 3 + 2) * IMAGE + cell;
+        let red = 7 * 3 * PLANE + cell;
+        let blue = (7 * 3 + 2) * PLANE + cell;
         assert!((linear(&swapped, red) - linear(data.input(0), blue)).abs() < 1e-5);
         assert!((linear(&swapped, blue) - linear(data.input(0), red)).abs() < 1e-5);
         let (mixed, _) = sample_layout(&data, Sample::Mixture { a: 0, b: 1, t: 0.25 }).unwrap();
         let want = 0.25 * linear(data.input(0), red) + 0.75 * linear(data.input(1), red);
         assert!((linear(&mixed, red) - want).abs() < 1e-5 * want.abs().max(1.0));
         // Invalid cells stay 0.
-        let invalid = (0..INPUT_VALUES).find(|&i| data.mask(0)[i] == 0.0).unwrap();
+        let invalid = (0..LAYOUT_VALUES).find(|&i| data.mask(0)[i] == 0.0).unwrap();
         assert_eq!(mixed[invalid], 0.0);
         let no_reference = TrainingSet::from_layouts(
             "x",
@@ -350,8 +348,8 @@ mod tests {
         let linear =
             |x: &[f32], i: usize| inverse_log_relative(f64::from(x[i]), f64::from(reference[i]));
         let mut clamped = 0;
-        for i in (0..INPUT_VALUES).filter(|&i| data.mask(1)[i] != 0.0).step_by(997) {
-            let colour = (i / IMAGE) % 3;
+        for i in (0..LAYOUT_VALUES).filter(|&i| data.mask(1)[i] != 0.0).step_by(997) {
+            let colour = (i / PLANE) % 3;
             let want = (linear(data.input(1), i) - (1.0 - scale) * floors[colour]).max(0.0);
             clamped += usize::from(want == 0.0);
             assert!((linear(&lowered, i) - want).abs() < 1e-5, "value {i}");

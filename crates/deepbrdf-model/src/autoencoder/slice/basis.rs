@@ -1,14 +1,14 @@
-//! The fixed linear parts of the `slice` preset's network ([`crate::autoencoder::slice_network`];
-//! not in the paper, issue 13): one basis of M directions for a single (theta_h, theta_d) image of
-//! the §3.2 layout, shared by all 540 images (180 phi_d slices x 3 colours) of every BRDF, and the
-//! principal components of the BRDFs' coefficients in it.
+//! The fixed linear parts of the `slice` network ([`super::network`]; not in the paper): one
+//! basis of M directions for a single (theta_h, theta_d) image of the §3.2 layout, shared by
+//! all 540 images (180 phi_d slices x 3 colours) of every BRDF, and the principal components of
+//! the BRDFs' coefficients in it.
 //!
 //! - [`fit_slice_basis`]: the M leading principal directions (uncentred, so the mean shape is
-//!   in the span) of the masked mapped images of a training set (every third phi_d slice) (eq. (1) space, invalid
-//!   cells 0), found by randomized subspace iteration (Halko et al. 2011): the 8100 x 8100 second
-//!   moment `sum_i X_i^T X_i` is applied to a block of vectors a few times, never formed. 100
-//!   BRDFs give 54,000 images for 8100 values: a basis learned from many more samples than the
-//!   100 whole tables of the `cpu` preset's basis, and 64 x 8100 values instead of 96 x 4.37 M.
+//!   in the span) of the masked mapped images of a training set (every third phi_d slice)
+//!   (eq. (1) space, invalid cells 0), found by randomized subspace iteration (Halko et al.
+//!   2011): the 8100 x 8100 second moment `sum_i X_i^T X_i` is applied to a block of vectors a
+//!   few times, never formed. The images of a training set are many more samples of 8100
+//!   values than its BRDFs are of whole tables.
 //! - [`project`]: the 540 x M coefficients of one layout and its squared distance to the span.
 //! - [`fit_components`]: the leading principal directions of the coefficient vectors (the Gram
 //!   route of [`deepbrdf_data::gram_pca`]), the network's linear path: with its MLPs at zero the
@@ -23,12 +23,10 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use crate::autoencoder::{INPUT_CHANNELS, INPUT_VALUES};
 use crate::error::{ModelError, Result};
 use deepbrdf_data::gram_pca::{leading_eigenpairs, ordered_block_sum};
+use deepbrdf_data::layout::{LAYOUT_VALUES, PLANE, SLICE_CHANNELS as INPUT_CHANNELS, SLICE_VALUES};
 
-/// Values of one (theta_h, theta_d) image of the layout (90 x 90).
-pub const SLICE_VALUES: usize = INPUT_VALUES / INPUT_CHANNELS;
 /// Extra vectors of the subspace iteration beyond M (oversampling).
 const OVERSAMPLING: usize = 16;
 /// Applications of the second moment (the last one feeds the Rayleigh-Ritz step).
@@ -48,21 +46,17 @@ fn tensor_of(m: &DMatrix<f64>, device: &Device) -> Tensor<2> {
 /// The images of `layouts` stacked: `[540 * layouts, 8100]`.
 fn images(layouts: &[&[f32]], device: &Device) -> Tensor<2> {
     let values: Vec<f32> = layouts.iter().flat_map(|l| l.iter().copied()).collect();
-    Tensor::from_data(
-        TensorData::new(values, [INPUT_CHANNELS * layouts.len(), SLICE_VALUES]),
-        device,
-    )
+    Tensor::from_data(TensorData::new(values, [INPUT_CHANNELS * layouts.len(), PLANE]), device)
 }
 
 /// The images of every [`FIT_SLICE_STRIDE`]-th slice of `layouts`, stacked.
 fn strided_images(layouts: &[&[f32]], device: &Device) -> Tensor<2> {
-    let slice = 3 * SLICE_VALUES;
     let values: Vec<f32> = layouts
         .iter()
-        .flat_map(|l| l.chunks(slice).step_by(FIT_SLICE_STRIDE).flatten().copied())
+        .flat_map(|l| l.chunks(SLICE_VALUES).step_by(FIT_SLICE_STRIDE).flatten().copied())
         .collect();
-    let rows = values.len() / SLICE_VALUES;
-    Tensor::from_data(TensorData::new(values, [rows, SLICE_VALUES]), device)
+    let rows = values.len() / PLANE;
+    Tensor::from_data(TensorData::new(values, [rows, PLANE]), device)
 }
 
 fn read(t: Tensor<2>) -> Result<Vec<f32>> {
@@ -93,25 +87,27 @@ fn orthonormal(y: DMatrix<f64>) -> DMatrix<f64> {
 }
 
 /// The `m` leading directions of the images of `layouts` (each `540 * 90 * 90` mapped values in
-/// layout order, invalid cells 0): `m` orthonormal rows of [`SLICE_VALUES`] values, row-major.
+/// layout order, invalid cells 0): `m` orthonormal rows of [`PLANE`] values, row-major.
 pub fn fit_slice_basis(
     layouts: &[&[f32]],
     m: usize,
     seed: u64,
     device: &Device,
 ) -> Result<Vec<f32>> {
-    if layouts.is_empty() || m == 0 || m + OVERSAMPLING > SLICE_VALUES {
+    if layouts.is_empty() || m == 0 || m + OVERSAMPLING > PLANE {
         return Err(ModelError::Invalid(format!(
             "a slice basis of {m} directions from {} BRDFs",
             layouts.len()
         )));
     }
-    if let Some(i) = layouts.iter().position(|l| l.len() != INPUT_VALUES) {
-        return Err(ModelError::Invalid(format!("layout {i} does not have {INPUT_VALUES} values")));
+    if let Some(i) = layouts.iter().position(|l| l.len() != LAYOUT_VALUES) {
+        return Err(ModelError::Invalid(format!(
+            "layout {i} does not have {LAYOUT_VALUES} values"
+        )));
     }
     let width = m + OVERSAMPLING;
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x511c_eba5_15_u64);
-    let start = DMatrix::<f64>::from_fn(SLICE_VALUES, width, |_, _| rng.random_range(-1.0..1.0));
+    let start = DMatrix::<f64>::from_fn(PLANE, width, |_, _| rng.random_range(-1.0..1.0));
     let mut q = orthonormal(start);
     for _ in 1..PASSES {
         q = orthonormal(second_moment_times(layouts, &q, device)?);
@@ -125,12 +121,10 @@ pub fn fit_slice_basis(
     })?;
     let mut order: Vec<usize> = (0..width).collect();
     order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
-    let mut rows = vec![0f32; m * SLICE_VALUES];
+    let mut rows = vec![0f32; m * PLANE];
     for (j, &e) in order.iter().take(m).enumerate() {
         let direction = &q * eig.eigenvectors.column(e);
-        for (r, v) in
-            rows[j * SLICE_VALUES..(j + 1) * SLICE_VALUES].iter_mut().zip(direction.iter())
-        {
+        for (r, v) in rows[j * PLANE..(j + 1) * PLANE].iter_mut().zip(direction.iter()) {
             *r = *v as f32;
         }
     }
@@ -139,8 +133,8 @@ pub fn fit_slice_basis(
 
 /// The basis rows (`m x 8100`, row-major) as the tensor `B^T` (`[8100, m]`) on `device`.
 pub fn basis_t(basis: &[f32], device: &Device) -> Tensor<2> {
-    let m = basis.len() / SLICE_VALUES;
-    Tensor::<2>::from_data(TensorData::new(basis.to_vec(), [m, SLICE_VALUES]), device).transpose()
+    let m = basis.len() / PLANE;
+    Tensor::<2>::from_data(TensorData::new(basis.to_vec(), [m, PLANE]), device).transpose()
 }
 
 /// The coefficients of each of `layouts` in the basis (`basis_t` from [`basis_t`]): 540 x m
@@ -229,12 +223,12 @@ mod tests {
 
     /// Layouts whose every image is a mix of two fixed images.
     fn layouts() -> Vec<Vec<f32>> {
-        let a: Vec<f32> = (0..SLICE_VALUES).map(|i| ((i % 7) as f32 - 3.0) / 3.0).collect();
-        let b: Vec<f32> = (0..SLICE_VALUES).map(|i| ((i % 13) as f32) / 13.0).collect();
+        let a: Vec<f32> = (0..PLANE).map(|i| ((i % 7) as f32 - 3.0) / 3.0).collect();
+        let b: Vec<f32> = (0..PLANE).map(|i| ((i % 13) as f32) / 13.0).collect();
         (0..3)
             .map(|n| {
-                let mut out = vec![0f32; INPUT_VALUES];
-                for (image, chunk) in out.chunks_mut(SLICE_VALUES).enumerate() {
+                let mut out = vec![0f32; LAYOUT_VALUES];
+                for (image, chunk) in out.chunks_mut(PLANE).enumerate() {
                     let (p, q) = (((image + n) % 5) as f32, ((image * 3 + n) % 4) as f32 - 1.5);
                     for (i, v) in chunk.iter_mut().enumerate() {
                         *v = p * a[i] + q * b[i];
@@ -252,7 +246,7 @@ mod tests {
         let device = crate::device::DeviceKind::default_kind().unwrap().device().unwrap();
         let basis = fit_slice_basis(&refs, 3, 7, &device).unwrap();
         assert_eq!(basis, fit_slice_basis(&refs, 3, 7, &device).unwrap(), "deterministic");
-        let row = |j: usize| &basis[j * SLICE_VALUES..(j + 1) * SLICE_VALUES];
+        let row = |j: usize| &basis[j * PLANE..(j + 1) * PLANE];
         let dot =
             |x: &[f32], y: &[f32]| x.iter().zip(y).map(|(a, b)| f64::from(a * b)).sum::<f64>();
         for i in 0..3 {

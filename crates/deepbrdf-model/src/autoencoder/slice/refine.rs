@@ -1,12 +1,11 @@
-//! Encoding by optimisation (issue 13): the latent vector that minimises the eq. (4) error of
+//! Encoding by optimisation: the latent vector that minimises the eq. (4) error of
 //! the decoder's output (eq. 3) against the BRDF being encoded, found by Levenberg-Marquardt
 //! from the encoder's answer (eq. 2).
 //!
 //! The encoder f is amortised: trained on the training BRDFs, it can land far from the best
-//! latent of a BRDF it has never seen (held out, a few materials' errors were 3-4x PCA's while
-//! the decoder could represent them as well as PCA). Encoding is a small problem for the `slice`
+//! latent of a BRDF it has never seen (docs/model.md). Encoding is a small problem for the `slice`
 //! network: k unknowns, the error a sum of squares over its 540 x M output coefficients
-//! ([`crate::train::autoencoder`]: for an orthonormal slice basis the mapped error is the
+//! ([`super::step`]: for an orthonormal slice basis the mapped error is the
 //! coefficients' squared error plus a fixed residual), and the decoder costs a few milliseconds,
 //! so the Jacobian is taken by forward differences, all k + 1 decodes in one batch, and the
 //! damped Gauss-Newton step solved in f64. The decoder's MLP is piecewise linear (leaky ReLU),
@@ -22,7 +21,7 @@ use deepbrdf_data::merl::grid::cos_weights;
 use deepbrdf_data::merl::{cell_index, CELLS, N_PHI_D, N_THETA_D, N_THETA_H};
 use nalgebra::{DMatrix, DVector};
 
-use crate::autoencoder::slice_network::SliceNetwork;
+use super::network::SliceNetwork;
 use crate::error::{ModelError, Result};
 
 /// How an encoding is refined: `iterations` Levenberg-Marquardt steps (0: the encoder alone),

@@ -12,8 +12,19 @@ use burn::prelude::*;
 use burn::tensor::activation::leaky_relu;
 use burn::tensor::Distribution;
 
-use super::config::{AutoencoderConfig, ConvolutionalConfig};
-use super::{BOTTLENECK_SIDE, INPUT_CHANNELS, INPUT_SIDE};
+use deepbrdf_data::layout::{SIDE as INPUT_SIDE, SLICE_CHANNELS as INPUT_CHANNELS};
+
+use super::config::ConvolutionalConfig;
+use crate::autoencoder::init::initializers;
+
+/// Side of the bottleneck images after three stride-2 convolutions (90 -> 45 -> 23 -> 12).
+pub const BOTTLENECK_SIDE: usize = 12;
+
+/// A zero offset (set with [`crate::Autoencoder::with_offset`]), not trained.
+fn zero_offset(device: &Device) -> Param<Tensor<3>> {
+    Param::from_tensor(Tensor::zeros([INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE], device))
+        .set_require_grad(false)
+}
 
 /// The convolutional encoder and decoder.
 #[derive(Module, Debug)]
@@ -26,24 +37,26 @@ pub struct Convolutional {
     up: Vec<ConvTranspose2d>,
     project_out: Option<Projection>,
     /// Fixed per-value offset (the training mean in mapped space), not trained.
-    pub(super) offset: Option<Param<Tensor<3>>>,
+    pub(crate) offset: Option<Param<Tensor<3>>>,
     bottleneck_channels: usize,
-    pub(super) latent: usize,
+    pub(crate) latent: usize,
     negative_slope: f64,
 }
 
 impl Convolutional {
-    /// The layers of `layers` for `config`'s k and slope, freshly initialised (the layers are
-    /// built in a fixed order: eager draws first, lazy ones when the record is first taken).
-    pub(super) fn new(
-        config: &AutoencoderConfig,
+    /// The layers of `layers` for latent dimension `latent` and leaky ReLU slope
+    /// `negative_slope`, freshly initialised (the layers are built in a fixed order: eager
+    /// draws first, lazy ones when the record is first taken).
+    pub(crate) fn new(
+        latent: usize,
+        negative_slope: f64,
         layers: &ConvolutionalConfig,
         device: &Device,
     ) -> Self {
         let [e0, e1, e2] = layers.encoder_channels;
         let [d0, d1] = layers.decoder_channels;
         let first = layers.projection.unwrap_or(INPUT_CHANNELS);
-        let (hidden, linear) = config.initializers(layers.he_init);
+        let (hidden, linear) = initializers(layers.he_init, negative_slope);
         let down = |c_in: usize, c_out: usize| {
             Conv2dConfig::new([c_in, c_out], [3, 3])
                 .with_stride([2, 2])
@@ -70,10 +83,10 @@ impl Convolutional {
             residual: (0..layers.residual_blocks)
                 .map(|_| ResidualBlock::new(e2, &hidden, he, device))
                 .collect(),
-            to_latent: LinearConfig::new(bottleneck, config.latent)
+            to_latent: LinearConfig::new(bottleneck, latent)
                 .with_initializer(linear.clone())
                 .init(device),
-            from_latent: LinearConfig::new(config.latent, bottleneck)
+            from_latent: LinearConfig::new(latent, bottleneck)
                 .with_initializer(hidden.clone())
                 .init(device),
             // PyTorch ConvTranspose2d(c_in, c_out, 4, 2, 4): 48 -> (48 - 1) * 2 - 8 + 4 = 90.
@@ -93,10 +106,10 @@ impl Convolutional {
             project_out: layers
                 .projection
                 .map(|c| Projection::new(c, INPUT_CHANNELS, &linear, he, device)),
-            offset: layers.mean_offset.then(|| super::zero_offset(device)),
+            offset: layers.mean_offset.then(|| zero_offset(device)),
             bottleneck_channels: e2,
-            latent: config.latent,
-            negative_slope: config.negative_slope,
+            latent,
+            negative_slope,
         }
     }
 
@@ -104,7 +117,7 @@ impl Convolutional {
     ///
     /// # Shapes
     /// - centred: `[batch, 540, 90, 90]` -> `[batch, k]`
-    pub(super) fn encode_centred(&self, centred: Tensor<4>) -> Tensor<2> {
+    pub(crate) fn encode_centred(&self, centred: Tensor<4>) -> Tensor<2> {
         let slope = self.negative_slope;
         let batch = centred.dims()[0];
         let mut x = match &self.project_in {
@@ -125,7 +138,7 @@ impl Convolutional {
     ///
     /// # Shapes
     /// - latent: `[batch, k]` -> `[batch, 540, 90, 90]`
-    pub(super) fn decode_deviation(&self, latent: Tensor<2>) -> Tensor<4> {
+    pub(crate) fn decode_deviation(&self, latent: Tensor<2>) -> Tensor<4> {
         let slope = self.negative_slope;
         let batch = latent.dims()[0];
         let y = leaky_relu(self.from_latent.forward(latent), slope); // [batch, e2*144]
