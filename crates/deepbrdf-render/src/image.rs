@@ -271,6 +271,21 @@ impl Srgb8Image {
         }
     }
 
+    /// The image enlarged by the integer factor `f`, each pixel repeated `f x f` times
+    /// (nearest neighbour: a small render shown large stays sharp).
+    pub fn upscaled(&self, f: u32) -> Srgb8Image {
+        let (w, h) = (self.width * f, self.height * f);
+        let mut out = Srgb8Image::filled(w, h, [0, 0, 0]);
+        for y in 0..h {
+            for x in 0..w {
+                let s = 3 * ((y / f) * self.width + x / f) as usize;
+                let t = 3 * (y * w + x) as usize;
+                out.data[t..t + 3].copy_from_slice(&self.data[s..s + 3]);
+            }
+        }
+        out
+    }
+
     /// Encodes as PNG and writes it atomically.
     pub fn write_png(&self, path: &Path) -> Result<()> {
         let png = self.png_bytes().map_err(|e| RenderError::format(path, e.to_string()))?;
@@ -315,6 +330,16 @@ pub fn false_colour(t: f32) -> [u8; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn upscaling_repeats_each_pixel_in_a_block() {
+        let img = Srgb8Image { width: 2, height: 1, data: vec![1, 2, 3, 4, 5, 6] };
+        let up = img.upscaled(2);
+        assert_eq!((up.width, up.height), (4, 2));
+        let row = [1, 2, 3, 1, 2, 3, 4, 5, 6, 4, 5, 6];
+        assert_eq!(up.data, [row, row].concat());
+        assert_eq!(img.upscaled(1), img);
+    }
 
     #[test]
     fn srgb_round_trip_and_known_values() {

@@ -7,7 +7,6 @@ mod data_args;
 mod device_arg;
 mod editing;
 mod latent_file;
-mod measured_brdf;
 mod model_arg;
 mod progress;
 mod progress_log;

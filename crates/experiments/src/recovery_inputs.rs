@@ -1,12 +1,10 @@
 //! What single-image recovery (§5.2) reads from a render set, in one place for `train-recovery`,
 //! `recover` and `figures-recovery`: the images prepared for the network
-//! (`deepbrdf_render::Photo`), and the targets of a material: DeepBRDF's latent (eq. 2) or the
-//! 7 Lambertian + GGX attributes of §5.1 (roughness as its logarithm, the scale it varies on).
+//! (`deepbrdf_render::Photo`) and the materials' tables. The targets the networks learn are the
+//! library's ([`deepbrdf_eval::recovery`]).
 use anyhow::Context;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::{MerlTable, Progress};
-use deepbrdf_eval::attributes::{fit, Attributes, FitConfig, MAX_ROUGHNESS, MIN_ROUGHNESS};
-use deepbrdf_model::DeepBrdf;
 use deepbrdf_render::{Photo, RenderSet};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -110,59 +108,4 @@ pub fn load_tables(
         .collect::<anyhow::Result<BTreeMap<_, _>>>();
     progress.finish();
     tables
-}
-
-/// DeepBRDF's latent of each table.
-pub fn latents(
-    model: &DeepBrdf,
-    tables: &BTreeMap<String, MerlTable>,
-) -> anyhow::Result<BTreeMap<String, Vec<f32>>> {
-    tables.iter().map(|(n, t)| Ok((n.clone(), model.encode(t)?))).collect()
-}
-
-/// The 7 targets of attributes: diffuse RGB, specular RGB, ln(roughness).
-pub fn attribute_targets(a: &Attributes) -> Vec<f32> {
-    let v = a.to_array();
-    vec![
-        v[0] as f32,
-        v[1] as f32,
-        v[2] as f32,
-        v[3] as f32,
-        v[4] as f32,
-        v[5] as f32,
-        v[6].ln() as f32,
-    ]
-}
-
-/// Attributes from 7 predicted targets, clamped into their ranges.
-pub fn attributes_of(targets: &[f32]) -> anyhow::Result<Attributes> {
-    anyhow::ensure!(targets.len() == 7, "7 attribute outputs expected, got {}", targets.len());
-    let t: Vec<f64> = targets.iter().map(|&v| f64::from(v)).collect();
-    let albedo = |v: f64| v.clamp(0.0, 1.0);
-    let values = [
-        albedo(t[0]),
-        albedo(t[1]),
-        albedo(t[2]),
-        albedo(t[3]),
-        albedo(t[4]),
-        albedo(t[5]),
-        t[6].exp().clamp(MIN_ROUGHNESS, MAX_ROUGHNESS),
-    ];
-    Ok(Attributes::from_slice(&values)?)
-}
-
-/// The Lambertian + GGX fit of each table, as targets.
-pub fn attribute_fits(
-    tables: &BTreeMap<String, MerlTable>,
-    progress: &dyn Progress,
-) -> anyhow::Result<BTreeMap<String, Vec<f32>>> {
-    progress.start(tables.len() as u64, "fitting attributes");
-    let mut out = BTreeMap::new();
-    for (name, table) in tables {
-        let f = fit(table, &FitConfig::default()).with_context(|| format!("fitting {name}"))?;
-        out.insert(name.clone(), attribute_targets(&f.attributes));
-        progress.advance(1);
-    }
-    progress.finish();
-    Ok(out)
 }

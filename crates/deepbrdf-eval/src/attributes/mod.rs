@@ -92,6 +92,18 @@ impl Attributes {
         Ok(a)
     }
 
+    /// The blend `(1 - t) self + t other` of two materials' attributes, as the latent blend of
+    /// eq. (7) pairs them: the albedos linearly, the roughness in log space, as the regressor
+    /// sees it.
+    pub fn blend(&self, other: &Attributes, t: f64) -> Attributes {
+        let mix = |x: f64, y: f64| (1.0 - t) * x + t * y;
+        Attributes {
+            diffuse: [0, 1, 2].map(|c| mix(self.diffuse[c], other.diffuse[c])),
+            specular: [0, 1, 2].map(|c| mix(self.specular[c], other.specular[c])),
+            roughness: mix(self.roughness.ln(), other.roughness.ln()).exp(),
+        }
+    }
+
     /// The analytic BRDF, for the renderer (sampled as a mixture of its two terms).
     pub fn brdf(&self) -> Sum<Lambertian, Ggx> {
         Sum::plastic(self.diffuse, self.roughness, self.specular)
@@ -138,6 +150,22 @@ const INV_PI: f64 = 1.0 / PI;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_blend_mixes_albedos_linearly_and_the_roughness_in_log_space() {
+        let a = Attributes { diffuse: [0.2, 0.4, 0.6], specular: [0.0, 0.1, 0.2], roughness: 0.01 };
+        let b = Attributes { diffuse: [0.6, 0.4, 0.2], specular: [0.2, 0.1, 0.0], roughness: 1.0 };
+        let m = a.blend(&b, 0.5);
+        for (x, y) in m.diffuse.iter().zip([0.4, 0.4, 0.4]) {
+            assert!((x - y).abs() < 1e-12, "{m:?}");
+        }
+        for (x, y) in m.specular.iter().zip([0.1, 0.1, 0.1]) {
+            assert!((x - y).abs() < 1e-12, "{m:?}");
+        }
+        // The geometric mean of 0.01 and 1.
+        assert!((m.roughness - 0.1).abs() < 1e-12, "{m:?}");
+        assert_eq!(a.blend(&b, 0.0).diffuse, a.diffuse);
+    }
 
     #[test]
     fn attributes_round_trip_and_reject_out_of_range_values() {

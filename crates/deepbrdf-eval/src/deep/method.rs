@@ -32,6 +32,16 @@ pub enum FitOrigin {
     Trained,
 }
 
+impl FitOrigin {
+    /// The origin's name in reports (`training.csv`).
+    pub fn name(self) -> &'static str {
+        match self {
+            FitOrigin::Loaded => "loaded",
+            FitOrigin::Trained => "trained",
+        }
+    }
+}
+
 /// One fitted (fold, k): where it lives and how long it took.
 #[derive(Clone, Debug)]
 pub struct FitRecord {

@@ -102,24 +102,31 @@ impl Results {
                 m.label(),
                 self.materials().len()
             );
-            let _ = write!(s, "| method |");
-            self.ks.iter().for_each(|k| {
-                let _ = write!(s, " k = {k} |");
-            });
-            let _ = write!(s, "\n|---|");
-            self.ks.iter().for_each(|_| s.push_str("---:|"));
+            s.push_str(&self.measure_table(m));
             s.push('\n');
-            for method in &self.methods {
-                let _ = write!(s, "| {method} |");
-                for &k in &self.ks {
-                    match self.mean(method, k, m) {
-                        Some(v) => {
-                            let _ = write!(s, " {v:.4e} |");
-                        }
-                        None => s.push_str(" - |"),
+        }
+        s
+    }
+
+    /// The markdown table of one measure: one row per method, one column per k, the mean over
+    /// materials (`-` where a method was not scored at a k).
+    pub fn measure_table(&self, measure: Measure) -> String {
+        let mut s = String::from("| method |");
+        self.ks.iter().for_each(|k| {
+            let _ = write!(s, " k = {k} |");
+        });
+        s.push_str("\n|---|");
+        self.ks.iter().for_each(|_| s.push_str("---:|"));
+        s.push('\n');
+        for method in &self.methods {
+            let _ = write!(s, "| {method} |");
+            for &k in &self.ks {
+                match self.mean(method, k, measure) {
+                    Some(v) => {
+                        let _ = write!(s, " {v:.4e} |");
                     }
+                    None => s.push_str(" - |"),
                 }
-                s.push('\n');
             }
             s.push('\n');
         }

@@ -2,13 +2,13 @@
 //! paper's image-space error), RMSE and PSNR of the tonemapped images, and writes a false-colour
 //! difference image.
 use crate::data_args::CacheArg;
-use crate::measured_brdf::MeasuredBrdf;
 use crate::scene_args::SceneArgs;
 use anyhow::{bail, Context};
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::rgl::{bundled, RglBrdf};
 use deepbrdf_data::Progress;
 use deepbrdf_eval::metrics::{compare_images, difference_image};
+use deepbrdf_render::brdf::MeasuredBrdf;
 use deepbrdf_render::{render, MerlBrdf};
 use std::path::PathBuf;
 

@@ -14,30 +14,27 @@
 //! reported beside it.
 use crate::data_args::CacheArg;
 use crate::model_arg::ModelArg;
-use crate::recovery_inputs::{attributes_of, load_tables, set_images};
+use crate::recovery_inputs::{load_tables, set_images};
 use anyhow::{bail, Context};
-use deepbrdf_data::merl::{CELLS, INVALID_VALUE, VALUES};
-use deepbrdf_data::{MerlTable, Progress, Silent};
+use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::figures::{write_chart, LineChart, Series};
 use deepbrdf_eval::harness::{Measure, Yardstick};
 use deepbrdf_eval::metrics::{ImageRelae, ImageRelaeConfig};
+use deepbrdf_eval::recovery::{
+    attributes_from_targets, mean_table, nearest_materials, novel_scene,
+};
 use deepbrdf_eval::stats::{finite_mean, finite_median};
 use deepbrdf_model::recovery::{RecoveryArtifact, RecoveryTarget};
 use deepbrdf_model::DeepBrdf;
 use deepbrdf_render::sheet::{contact_sheet, SheetConfig, Tile};
 use deepbrdf_render::{
-    camera_png, render, MerlBrdf, Photo, RenderSet, RenderSettings, Sampler, SceneSampler, Shape,
-    Srgb8Image, Tonemap,
+    camera_png, Photo, RenderSet, RenderSettings, Sampler, Shape, Srgb8Image, Tonemap,
 };
-use rayon::prelude::*;
-use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
 /// The methods, in table order.
 const METHODS: [&str; 4] = ["deepbrdf", "analytic", "nearest", "mean"];
-/// Seed offset of the novel scenes (another stream than the inputs').
-const NOVEL_SEED: u64 = 0x6e6f_7665_6c;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -172,7 +169,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             let image = &set.images[i];
             let t = &truth[&image.material];
             let decoded = model.decode(&latents[j])?;
-            let fitted = attributes_of(&attributes[j])?.table();
+            let fitted = attributes_from_targets(&attributes[j])?.table();
             let near = &train_tables[&nearest[j]];
             let recon: [&MerlTable; 4] = [&decoded, &fitted, near, &mean];
             // The independent sampler, as the image RelAE default (the committed numbers).
@@ -253,101 +250,6 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     write_outputs(&args, &rows, &skipped, &shown, &planes, &model, &network, &analytic)
 }
 
-/// The novel scene of image `i`: drawn from another stream than the inputs', with another
-/// shape than the input's.
-fn novel_scene(set: &RenderSet, i: usize) -> deepbrdf_render::SceneConfig {
-    let sampler = SceneSampler::default();
-    let mut scene = sampler.sample(set.header.seed ^ NOVEL_SEED, i as u64).scene;
-    let input = set.images[i].scene.scene.shape;
-    if scene.shape.name() == input.name() {
-        let k = sampler.shapes.iter().position(|s| s.name() == input.name()).unwrap_or(0);
-        scene.shape = sampler.shapes[(k + 1) % sampler.shapes.len()];
-        if matches!(scene.shape, Shape::Plane { .. }) {
-            scene.view_theta_deg = scene.view_theta_deg.min(sampler.plane_view_theta_deg[1]);
-        }
-    }
-    scene
-}
-
-/// The per-value mean of `tables` over the cells valid in all of them (others invalid).
-fn mean_table(tables: &[&MerlTable]) -> anyhow::Result<MerlTable> {
-    anyhow::ensure!(!tables.is_empty(), "no training material for the mean");
-    let mut values = vec![0f32; VALUES];
-    values.par_chunks_mut(CELLS).enumerate().for_each(|(c, out)| {
-        for (cell, v) in out.iter_mut().enumerate() {
-            let i = c * CELLS + cell;
-            if tables.iter().all(|t| t.is_valid(cell)) {
-                *v = (tables.iter().map(|t| f64::from(t.values()[i])).sum::<f64>()
-                    / tables.len() as f64) as f32;
-            } else {
-                *v = INVALID_VALUE;
-            }
-        }
-    });
-    Ok(MerlTable::from_values(values)?)
-}
-
-/// For each image of `set` with these indices (`inputs` in their order), the training material whose render in the image's own scene
-/// (same seed and exposure, `spp` samples, no noise), prepared like the input, is closest to the prepared input
-/// (squared distance).
-fn nearest_materials(
-    set: &RenderSet,
-    indices: &[usize],
-    inputs: &[f32],
-    side: usize,
-    train: &BTreeMap<String, MerlTable>,
-    spp: u32,
-    progress: &dyn Progress,
-) -> anyhow::Result<Vec<String>> {
-    let per = 3 * side * side;
-    let n = indices.len();
-    let mut best = vec![(f64::INFINITY, String::new()); n];
-    let scenes: Vec<deepbrdf_render::Scene> = indices
-        .iter()
-        .map(|&i| set.images[i].scene.scene.build())
-        .collect::<Result<Vec<_>, _>>()?;
-    progress.start(train.len() as u64, "nearest neighbours");
-    for (name, table) in train {
-        let brdf = MerlBrdf::new(table);
-        let distances: Vec<f64> = (0..n)
-            .into_par_iter()
-            .map(|i| {
-                let im = &set.images[indices[i]];
-                let settings = RenderSettings {
-                    size: set.header.size,
-                    spp,
-                    seed: im.scene.render_seed,
-                    jitter: true,
-                    sampler: Sampler::Sobol,
-                };
-                let Ok(linear) = render(&scenes[i], &brdf, &settings, &Silent) else {
-                    return f64::INFINITY;
-                };
-                let png = camera_png(&linear, im.scene.exposure, 0.0, 0);
-                match Photo::from_srgb8(&png).network_input(side as u32, name) {
-                    Ok(x) => x
-                        .iter()
-                        .zip(&inputs[i * per..(i + 1) * per])
-                        .map(|(a, b)| f64::from(a - b).powi(2))
-                        .sum(),
-                    Err(_) => f64::INFINITY,
-                }
-            })
-            .collect();
-        for (b, d) in best.iter_mut().zip(distances) {
-            if d < b.0 {
-                *b = (d, name.clone());
-            }
-        }
-        progress.advance(1);
-    }
-    progress.finish();
-    if let Some(i) = best.iter().position(|b| b.1.is_empty()) {
-        bail!("image {}: no training material renders to a usable image in its scene", indices[i]);
-    }
-    Ok(best.into_iter().map(|b| b.1).collect())
-}
-
 #[allow(clippy::too_many_arguments)]
 fn write_outputs(
     args: &Args,
@@ -425,7 +327,7 @@ fn write_outputs(
     print!("{md}");
 
     let short = |m: &str| m.rsplit('/').next().unwrap_or(m).to_string();
-    let up = |img: &Srgb8Image| upscale(img, (128 / img.width.max(1)).max(1));
+    let up = |img: &Srgb8Image| img.upscaled((128 / img.width.max(1)).max(1));
     if !shown.is_empty() {
         let mut tiles = Vec::new();
         for (row, caption) in [(0, "input"), (1, "ground truth"), (2, "DeepBRDF")] {
@@ -510,18 +412,4 @@ fn per_material_chart(rows: &[Row], set: &str, stem: &std::path::Path) -> anyhow
     };
     write_chart(&chart, stem)?;
     Ok(())
-}
-
-/// Nearest-neighbour enlargement by an integer factor.
-fn upscale(img: &Srgb8Image, f: u32) -> Srgb8Image {
-    let (w, h) = (img.width * f, img.height * f);
-    let mut out = Srgb8Image::filled(w, h, [0, 0, 0]);
-    for y in 0..h {
-        for x in 0..w {
-            let s = 3 * ((y / f) * img.width + x / f) as usize;
-            let t = 3 * (y * w + x) as usize;
-            out.data[t..t + 3].copy_from_slice(&img.data[s..s + 3]);
-        }
-    }
-    out
 }

@@ -5,10 +5,11 @@
 //! `DIR/recovery` and names the model whose latent it predicts.
 use crate::data_args::CacheArg;
 use crate::model_arg::ModelArg;
-use crate::recovery_inputs::{attribute_fits, latents, load_tables, set_images};
+use crate::recovery_inputs::{load_tables, set_images};
 use anyhow::bail;
 use deepbrdf_data::lock::FolderLock;
 use deepbrdf_data::Progress;
+use deepbrdf_eval::recovery::{attribute_fits, latents};
 use deepbrdf_model::recovery::artifact::RECOVERY_DIR;
 use deepbrdf_model::recovery::{
     train_recovery, RecoveryArtifact, RecoveryData, RecoveryPreset, RecoveryProvenance,
