@@ -4,6 +4,7 @@
 pub mod checksums;
 pub mod downloader;
 pub mod error;
+mod http;
 
 pub use checksums::{ChecksumEntry, ChecksumTable};
 pub use downloader::{

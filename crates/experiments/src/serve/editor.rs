@@ -12,7 +12,7 @@
 //! when the material is opened; the refined one builds the edited table's own sampler and
 //! renders [`REFINED`] in passes.
 use super::request::{
-    check_upload_name, AttributesJson, Catalogue, CheckedEdit, Quality, Refusal, UPLOAD_COLLECTION,
+    check_upload_name, Catalogue, CheckedEdit, Quality, Refusal, UPLOAD_COLLECTION,
 };
 use crate::editing::{self, ModelCodec, Space};
 use crate::latent_file::LatentFile;
@@ -26,14 +26,19 @@ use deepbrdf_model::DeepBrdf;
 use deepbrdf_render::{
     render, Image, MerlBrdf, MerlSampling, RenderSettings, Sampler, Scene, SceneConfig, Tonemap,
 };
-use serde::Serialize;
 use sha2::{Digest, Sha256};
-use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::Instant;
 use tokio::sync::oneshot;
+
+use super::queue::{Job, PreviewJob, Queue, Reply, Shared};
+use super::recent::Recent;
+use super::replies::internal;
+pub use super::replies::{
+    Download, DownloadFile, Failure, MaterialInfo, ModelInfo, Preview, Seconds,
+};
 
 /// The fast preview: 128 px, 4 samples per pixel.
 pub const FAST: RenderSettings =
@@ -59,130 +64,6 @@ const DECODED_TABLES: usize = 4;
 const ORIGINAL_RENDERS: usize = 32;
 /// Background of the previews (8-bit sRGB), behind the shape.
 const BACKGROUND: [u8; 3] = [40, 40, 44];
-
-/// Why a job has no result.
-#[derive(Debug)]
-pub enum Failure {
-    /// The request is wrong (4xx).
-    Refused(Refusal),
-    /// A newer preview replaced this one.
-    Superseded,
-    /// Something failed in the server (500).
-    Internal(String),
-}
-
-impl From<Refusal> for Failure {
-    fn from(r: Refusal) -> Self {
-        Self::Refused(r)
-    }
-}
-
-impl From<anyhow::Error> for Failure {
-    fn from(e: anyhow::Error) -> Self {
-        Self::Internal(format!("{e:#}"))
-    }
-}
-
-impl From<deepbrdf_eval::EvalError> for Failure {
-    fn from(e: deepbrdf_eval::EvalError) -> Self {
-        anyhow::Error::from(e).into()
-    }
-}
-
-fn internal(e: impl std::fmt::Display) -> Failure {
-    Failure::Internal(e.to_string())
-}
-
-type Reply<T> = oneshot::Sender<Result<T, Failure>>;
-
-/// An opened material, as the page sees it.
-#[derive(Debug, Clone, Serialize)]
-pub struct MaterialInfo {
-    pub id: String,
-    pub name: String,
-    /// The attributes fitted to its table (the library's fit).
-    pub attributes: AttributesJson,
-    /// Its latent (eq. 2).
-    pub latent: Vec<f32>,
-}
-
-/// A rendered preview of an edit.
-#[derive(Debug, Clone, Serialize)]
-pub struct Preview {
-    #[serde(skip)]
-    pub png: Vec<u8>,
-    pub quality: Quality,
-    pub size: u32,
-    pub spp: u32,
-    /// The latent of the edit (decoded to the previewed table).
-    pub latent: Vec<f32>,
-    /// The attributes asked for.
-    pub requested: AttributesJson,
-    /// The attributes of the unedited (blended) material the edit starts from.
-    pub base: AttributesJson,
-    /// Re-estimated on the decoded table (refined previews only; the quick fit).
-    pub achieved: Option<AttributesJson>,
-    /// Seconds in the editor: regressor, decode (0 when cached), render, all.
-    pub seconds: Seconds,
-}
-
-#[derive(Debug, Clone, Copy, Default, Serialize)]
-pub struct Seconds {
-    pub regressor: f64,
-    pub decode: f64,
-    pub render: f64,
-    pub total: f64,
-}
-
-/// What to download.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Download {
-    /// The edited MERL `.binary` table.
-    Binary,
-    /// The edited latent as a latent file (JSON).
-    Latent,
-}
-
-/// A file to send: its name and bytes.
-pub struct DownloadFile {
-    pub file_name: String,
-    pub bytes: Vec<u8>,
-}
-
-enum Job {
-    Open { id: String, reply: Reply<MaterialInfo> },
-    Upload { file_name: String, bytes: Vec<u8>, reply: Reply<MaterialInfo> },
-    Original { id: String, scene: SceneConfig, reply: Reply<Vec<u8>> },
-    Download { edit: CheckedEdit, what: Download, reply: Reply<DownloadFile> },
-}
-
-struct PreviewJob {
-    edit: CheckedEdit,
-    quality: Quality,
-    generation: u64,
-    reply: Reply<Preview>,
-}
-
-#[derive(Default)]
-struct Queue {
-    jobs: VecDeque<Job>,
-    preview: Option<PreviewJob>,
-}
-
-struct Shared {
-    queue: Mutex<Queue>,
-    wake: Condvar,
-    /// Generation of the newest preview submitted.
-    latest: AtomicU64,
-}
-
-/// The model the server edits with.
-#[derive(Debug, Clone, Serialize)]
-pub struct ModelInfo {
-    pub model_id: String,
-    pub k: usize,
-    pub model_dir: String,
-}
 
 /// The handlers' side of the editor: submit jobs, await replies. Cheap to clone.
 #[derive(Clone)]
@@ -311,32 +192,6 @@ impl Material {
             attributes: (&self.attributes).into(),
             latent: self.latent.clone(),
         }
-    }
-}
-
-/// A small most-recently-used list.
-struct Recent<K, V> {
-    items: VecDeque<(K, V)>,
-    capacity: usize,
-}
-
-impl<K: PartialEq, V: Clone> Recent<K, V> {
-    fn new(capacity: usize) -> Self {
-        Self { items: VecDeque::new(), capacity }
-    }
-
-    fn get(&mut self, key: &K) -> Option<V> {
-        let i = self.items.iter().position(|(k, _)| k == key)?;
-        let item = self.items.remove(i)?;
-        let value = item.1.clone();
-        self.items.push_front(item);
-        Some(value)
-    }
-
-    fn put(&mut self, key: K, value: V) {
-        self.items.retain(|(k, _)| k != &key);
-        self.items.push_front((key, value));
-        self.items.truncate(self.capacity);
     }
 }
 
@@ -502,19 +357,7 @@ impl Editor {
             return Ok((a.latent.clone(), a.attributes, a));
         };
         let b = self.material(other)?;
-        let mix = |x: f64, y: f64| (1.0 - t) * x + t * y;
-        let (da, db, sa, sb) = (
-            a.attributes.diffuse,
-            b.attributes.diffuse,
-            a.attributes.specular,
-            b.attributes.specular,
-        );
-        let attributes = Attributes {
-            diffuse: [0, 1, 2].map(|c| mix(da[c], db[c])),
-            specular: [0, 1, 2].map(|c| mix(sa[c], sb[c])),
-            // Blended in log space, as the regressor sees the roughness.
-            roughness: mix(a.attributes.roughness.ln(), b.attributes.roughness.ln()).exp(),
-        };
+        let attributes = a.attributes.blend(&b.attributes, *t);
         Ok((editing::blend(&a.latent, &b.latent, *t), attributes, a))
     }
 

@@ -1,4 +1,4 @@
-//! The browser material editor of `experiments serve` (issue 14; §5.1's edits, interactively):
+//! The browser material editor of `experiments serve` (§5.1's edits, interactively):
 //! one axum router serving one embedded page ([`PAGE`], no external scripts or fonts) and a
 //! small JSON API over the [`editor`] worker. [`request`] checks what the page sends.
 //!
@@ -17,6 +17,9 @@
 //! request names is read from or written to disk except the server's cache (bundled materials
 //! are named by id, uploads are parsed in memory).
 pub mod editor;
+mod queue;
+mod recent;
+mod replies;
 pub mod request;
 
 use axum::body::Body;
