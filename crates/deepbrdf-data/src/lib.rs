@@ -13,6 +13,7 @@ pub mod layout;
 pub mod lock;
 pub mod mapping;
 pub mod merl;
+pub mod named;
 pub mod nbrdf;
 pub mod network_input;
 pub mod progress;

@@ -23,7 +23,7 @@ use deepbrdf_data::mapping::MedianReference;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
-use crate::atomic::{read_limited, write_atomic};
+use crate::atomic::{check_format, read_limited, write_atomic, write_manifest};
 use crate::autoencoder::{retired_network, Autoencoder, AutoencoderConfig};
 use crate::error::{ModelError, Result};
 use crate::train::Trained;
@@ -249,9 +249,7 @@ impl ModelArtifact {
             reference: self.parts.reference.clone(),
             basis: None,
         };
-        let json = serde_json::to_string_pretty(&manifest)
-            .map_err(|e| ModelError::Invalid(format!("cannot serialise the manifest: {e}")))?;
-        write_atomic(&dir.join(MANIFEST_FILE), &[json.as_bytes(), b"\n"])
+        write_manifest(&dir.join(MANIFEST_FILE), &manifest)
     }
 
     /// Loads an artifact directory, or a training output directory holding one in `model/`,
@@ -304,15 +302,7 @@ impl ModelArtifact {
 fn parse_manifest(path: &Path, text: &[u8]) -> Result<(Manifest, AutoencoderConfig)> {
     let manifest: Manifest = serde_json::from_slice(text)
         .map_err(|e| ModelError::format(path, format!("not a DeepBRDF model manifest: {e}")))?;
-    if manifest.format != FORMAT || !(1..=VERSION).contains(&manifest.version) {
-        return Err(ModelError::format(
-            path,
-            format!(
-                "format {} version {}, expected {FORMAT} version 1 to {VERSION}",
-                manifest.format, manifest.version
-            ),
-        ));
-    }
+    check_format(path, (&manifest.format, manifest.version), FORMAT, 1..=VERSION)?;
     let retired = match manifest.basis.is_some() {
         true => Some("the spectral network of the retired `cpu` preset, with its basis.f16"),
         false => retired_network(&manifest.config),

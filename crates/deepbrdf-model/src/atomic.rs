@@ -1,9 +1,13 @@
 //! Crash-safe file access of the model crate: atomic writes (through the data crate's one writer:
-//! a reader, or a run killed mid-write, sees the old file or the new one, never a mixture) and
-//! size-limited reads.
+//! a reader, or a run killed mid-write, sees the old file or the new one, never a mixture),
+//! size-limited reads, and the manifests every saved network carries (written as pretty JSON,
+//! their format and version checked on reading).
 
 use std::fs;
+use std::ops::RangeInclusive;
 use std::path::Path;
+
+use serde::Serialize;
 
 use crate::error::{ModelError, Result};
 
@@ -11,6 +15,34 @@ use crate::error::{ModelError, Result};
 /// [`deepbrdf_data::files::write_atomic_parts`] (unique temporary name, fsync, rename).
 pub fn write_atomic(path: &Path, parts: &[&[u8]]) -> Result<()> {
     Ok(deepbrdf_data::files::write_atomic_parts(path, parts)?)
+}
+
+/// Writes `manifest` to `path` as pretty-printed JSON with a final newline, atomically.
+pub fn write_manifest(path: &Path, manifest: &impl Serialize) -> Result<()> {
+    let json = serde_json::to_string_pretty(manifest)
+        .map_err(|e| ModelError::Invalid(format!("cannot serialise the manifest: {e}")))?;
+    write_atomic(path, &[json.as_bytes(), b"\n"])
+}
+
+/// Checks the `format` and `version` a manifest read from `path` declares against the format
+/// this build reads (`expected`) and the versions it understands.
+pub fn check_format(
+    path: &Path,
+    (format, version): (&str, u32),
+    expected: &str,
+    versions: RangeInclusive<u32>,
+) -> Result<()> {
+    if format == expected && versions.contains(&version) {
+        return Ok(());
+    }
+    let wanted = match versions.start() == versions.end() {
+        true => format!("version {}", versions.start()),
+        false => format!("version {} to {}", versions.start(), versions.end()),
+    };
+    Err(ModelError::format(
+        path,
+        format!("format {format} version {version}, expected {expected} {wanted}"),
+    ))
 }
 
 /// Reads a whole file, refusing ones larger than `limit` bytes (a foreign or damaged file must
@@ -43,5 +75,27 @@ mod tests {
         assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
         assert!(read_limited(&path, 2).is_err());
         assert_eq!(read_limited(&path, 3).unwrap(), b"new");
+    }
+
+    #[test]
+    fn formats_and_versions_outside_what_is_read_are_refused_by_name() {
+        let path = Path::new("dir/model.json");
+        assert!(check_format(path, ("f", 2), "f", 1..=2).is_ok());
+        let e = check_format(path, ("f", 3), "f", 1..=2).unwrap_err().to_string();
+        assert!(
+            e.contains("dir/model.json")
+                && e.ends_with("format f version 3, expected f version 1 to 2"),
+            "{e}"
+        );
+        let e = check_format(path, ("g", 1), "f", 1..=1).unwrap_err().to_string();
+        assert!(e.ends_with("format g version 1, expected f version 1"), "{e}");
+    }
+
+    #[test]
+    fn a_manifest_is_pretty_json_with_a_final_newline() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.json");
+        write_manifest(&path, &serde_json::json!({"a": 1})).unwrap();
+        assert_eq!(fs::read_to_string(&path).unwrap(), "{\n  \"a\": 1\n}\n");
     }
 }

@@ -1,7 +1,6 @@
 //! Run-time choice of the compute device among the backends compiled in (cargo features
 //! `flex` (default), `ndarray`, `wgpu`, `cuda`).
 
-use std::fmt;
 use std::str::FromStr;
 
 /// A backend this binary can run on, chosen with `--device`.
@@ -18,11 +17,15 @@ pub enum DeviceKind {
     Cuda,
 }
 
-impl DeviceKind {
-    /// Every kind, compiled in or not.
-    pub const ALL: [DeviceKind; 4] =
-        [DeviceKind::Flex, DeviceKind::Ndarray, DeviceKind::Wgpu, DeviceKind::Cuda];
+// Every kind, compiled in or not, by its cargo feature's name (the `--device` name).
+deepbrdf_data::named_enum!(DeviceKind {
+    Flex => "flex",
+    Ndarray => "ndarray",
+    Wgpu => "wgpu",
+    Cuda => "cuda",
+});
 
+impl DeviceKind {
     /// Whether this binary was built with the kind's cargo feature.
     pub fn is_compiled(self) -> bool {
         match self {
@@ -63,22 +66,6 @@ impl DeviceKind {
             )),
         }
     }
-
-    /// The cargo feature (and `--device` name) of this kind.
-    pub fn name(self) -> &'static str {
-        match self {
-            DeviceKind::Flex => "flex",
-            DeviceKind::Ndarray => "ndarray",
-            DeviceKind::Wgpu => "wgpu",
-            DeviceKind::Cuda => "cuda",
-        }
-    }
-}
-
-impl fmt::Display for DeviceKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
 }
 
 impl FromStr for DeviceKind {
@@ -86,10 +73,9 @@ impl FromStr for DeviceKind {
 
     /// Parses a device name; refuses kinds not compiled in, naming the feature to build with.
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let kind =
-            Self::ALL.into_iter().find(|k| k.name().eq_ignore_ascii_case(s.trim())).ok_or_else(
-                || format!("unknown device '{s}': expected one of flex, ndarray, wgpu, cuda"),
-            )?;
+        let kind = Self::from_name(s).ok_or_else(|| {
+            format!("unknown device '{s}': expected one of flex, ndarray, wgpu, cuda")
+        })?;
         if !kind.is_compiled() {
             let have: Vec<_> = Self::available().iter().map(|k| k.name()).collect();
             return Err(format!(

@@ -1,7 +1,6 @@
 //! Named settings: `paper` (Table 1 and §3.2's training) and `slice` (the network shared
 //! across phi_d slices that ships as the default model).
 
-use std::fmt;
 use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
@@ -19,10 +18,9 @@ pub enum Preset {
     Slice,
 }
 
-impl Preset {
-    /// Every preset.
-    pub const ALL: [Preset; 2] = [Preset::Paper, Preset::Slice];
+deepbrdf_data::named_enum!(Preset { Paper => "paper", Slice => "slice" });
 
+impl Preset {
     /// The preset's training configuration for latent dimension `k`.
     pub fn train_config(self, k: usize) -> TrainConfig {
         match self {
@@ -30,31 +28,15 @@ impl Preset {
             Preset::Slice => TrainConfig::slice(k),
         }
     }
-
-    /// The preset's name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Preset::Paper => "paper",
-            Preset::Slice => "slice",
-        }
-    }
-}
-
-impl fmt::Display for Preset {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
 }
 
 impl FromStr for Preset {
     type Err = String;
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::ALL.into_iter().find(|p| p.name().eq_ignore_ascii_case(s.trim())).ok_or_else(|| {
-            match s.trim().eq_ignore_ascii_case("cpu") {
-                true => format!("the preset '{s}' was retired: use slice (the shipped model's)"),
-                false => format!("unknown preset '{s}': expected paper or slice"),
-            }
+        Self::from_name(s).ok_or_else(|| match s.trim().eq_ignore_ascii_case("cpu") {
+            true => format!("the preset '{s}' was retired: use slice (the shipped model's)"),
+            false => format!("unknown preset '{s}': expected paper or slice"),
         })
     }
 }

@@ -46,7 +46,9 @@ pub struct Tile {
 /// Smallest caption font size.
 const MIN_FONT_PX: u32 = 7;
 
-fn register_font() -> Result<()> {
+/// Registers the embedded DejaVu Sans as plotters' `sans-serif` (once per process), for the
+/// captions here and the charts of `deepbrdf-eval`: no figure depends on the system's fonts.
+pub fn register_font() -> Result<()> {
     static REGISTERED: OnceLock<bool> = OnceLock::new();
     let ok = *REGISTERED.get_or_init(|| {
         plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular())

@@ -40,7 +40,7 @@ pub fn mode_parser() -> impl clap::builder::TypedValueParser<Value = EditMode> {
 }
 
 /// The fit used to re-estimate the attributes of decoded tables in the measures: the
-/// library's, on a quarter of its cells (theta_d every 8th, phi_d every 16th; ~0.15 s).
+/// library's, on a quarter of its cells (theta_d every 8th, phi_d every 16th).
 pub fn quick_fit() -> FitConfig {
     FitConfig { theta_d_stride: 8, phi_d_stride: 16, ..FitConfig::default() }
 }
@@ -161,4 +161,13 @@ pub fn ipca_editor(
         }
     };
     Ok((ipca, regressor))
+}
+
+impl EditorArg {
+    /// The model directory, and the model with its DeepBRDF regressor ([`load_editor`]).
+    pub fn load(&self, device: &Device) -> anyhow::Result<(PathBuf, DeepBrdf, Regressor)> {
+        let model_dir = self.model.dir()?;
+        let (model, regressor) = load_editor(&model_dir, self.regressor.as_deref(), device)?;
+        Ok((model_dir, model, regressor))
+    }
 }

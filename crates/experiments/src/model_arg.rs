@@ -20,6 +20,25 @@ pub struct ModelArg {
     pub model: Option<PathBuf>,
 }
 
+/// `[MODEL] MATERIAL` of `encode` and `reconstruct`: the material, and before it, optionally,
+/// the model (the earlier form of `--model DIR`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct ModelMaterialArg {
+    /// [MODEL] MATERIAL: a MERL .binary file or the name of a bundled material; before it, optionally, a trained
+    /// model (the earlier form of `--model DIR`).
+    #[arg(value_name = "[MODEL] MATERIAL", num_args = 1..=2, required = true)]
+    pub inputs: Vec<String>,
+    #[command(flatten)]
+    pub model: ModelArg,
+}
+
+impl ModelMaterialArg {
+    /// The model directory and the material ([`ModelArg::with_positional`]).
+    pub fn resolve(&self) -> anyhow::Result<(PathBuf, String)> {
+        self.model.with_positional(&self.inputs)
+    }
+}
+
 impl ModelArg {
     /// The model directory to load: the one given, else the shipped default.
     pub fn dir(&self) -> anyhow::Result<PathBuf> {

@@ -7,12 +7,31 @@ use std::sync::Mutex;
 /// Progress bars on stderr, one phase at a time.
 pub struct Bars {
     visible: bool,
+    /// The indicatif template of each bar.
+    template: &'static str,
     bar: Mutex<Option<ProgressBar>>,
 }
 
 impl Bars {
+    /// Bars counting items (position of length, elapsed time).
     pub fn new(quiet: bool) -> Self {
-        Self { visible: !quiet && std::io::stderr().is_terminal(), bar: Mutex::new(None) }
+        Self::with_template(
+            quiet,
+            "{msg:24} [{bar:30}] {pos}/{len} {elapsed_precise} eta {eta} {prefix}",
+        )
+    }
+
+    /// Bars counting bytes (bytes of total, rate; the status names the current file).
+    pub fn bytes(quiet: bool) -> Self {
+        Self::with_template(
+            quiet,
+            "{msg:22} [{bar:30}] {bytes}/{total_bytes} {binary_bytes_per_sec} eta {eta} {prefix}",
+        )
+    }
+
+    fn with_template(quiet: bool, template: &'static str) -> Self {
+        let visible = !quiet && std::io::stderr().is_terminal();
+        Self { visible, template, bar: Mutex::new(None) }
     }
 }
 
@@ -22,11 +41,9 @@ impl Progress for Bars {
             Some(len),
             if self.visible { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() },
         );
-        let style = ProgressStyle::with_template(
-            "{msg:24} [{bar:30}] {pos}/{len} {elapsed_precise} eta {eta} {prefix}",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar())
-        .progress_chars("=> ");
+        let style = ProgressStyle::with_template(self.template)
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> ");
         bar.set_style(style);
         bar.set_message(message.to_string());
         if let Ok(mut slot) = self.bar.lock() {

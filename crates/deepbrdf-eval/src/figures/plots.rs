@@ -9,7 +9,6 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::FontTransform;
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 
 /// One line of a chart.
 #[derive(Clone, Debug)]
@@ -38,19 +37,6 @@ pub struct LineChart {
     pub size: (u32, u32),
 }
 
-fn register_font() -> Result<()> {
-    static REGISTERED: OnceLock<bool> = OnceLock::new();
-    let ok = *REGISTERED.get_or_init(|| {
-        plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular())
-            .is_ok()
-    });
-    if ok {
-        Ok(())
-    } else {
-        Err(EvalError::Invalid("the embedded DejaVu Sans font could not be loaded".into()))
-    }
-}
-
 /// Writes `chart` to `<stem>.svg` (through a temp file and a rename).
 pub fn write_chart(chart: &LineChart, stem: &Path) -> Result<()> {
     write_panels(std::slice::from_ref(chart), stem)
@@ -59,7 +45,7 @@ pub fn write_chart(chart: &LineChart, stem: &Path) -> Result<()> {
 /// Writes `charts` stacked top to bottom in one figure (width: the widest; height: the sum) to
 /// `<stem>.svg` (through a temp file and a rename).
 pub fn write_panels(charts: &[LineChart], stem: &Path) -> Result<()> {
-    register_font()?;
+    deepbrdf_render::sheet::register_font()?;
     if charts.is_empty() {
         return Err(EvalError::Invalid(format!("{}: no chart to draw", stem.display())));
     }

@@ -6,7 +6,6 @@ use deepbrdf_data::mapping::{log_relative, MedianReference};
 use deepbrdf_data::merl::{grid, CELLS, VALUES};
 use deepbrdf_data::MerlTable;
 use rayon::prelude::*;
-use std::fmt;
 use std::str::FromStr;
 
 /// A reconstruction error measure.
@@ -26,24 +25,20 @@ pub enum Measure {
     ImageRelae,
 }
 
+// All measures, in table order, by their machine names (CSV files, the command line).
+deepbrdf_data::named_enum!(Measure {
+    MappedMse => "mapped_mse",
+    CosRmse => "cos_rmse",
+    ImageRelae => "image_relae",
+});
+
 impl Measure {
-    /// All measures, in table order.
-    pub const ALL: [Measure; 3] = [Measure::MappedMse, Measure::CosRmse, Measure::ImageRelae];
     /// The measures computed on the tables alone (fast; the default).
     pub const TABLE: [Measure; 2] = [Measure::MappedMse, Measure::CosRmse];
 
     /// Whether the measure renders images (not computed by [`Yardstick::measure`]).
     pub fn renders(self) -> bool {
         self == Self::ImageRelae
-    }
-
-    /// Machine name, used in CSV files and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::MappedMse => "mapped_mse",
-            Self::CosRmse => "cos_rmse",
-            Self::ImageRelae => "image_relae",
-        }
     }
 
     /// Human label for plots and tables.
@@ -56,16 +51,10 @@ impl Measure {
     }
 }
 
-impl fmt::Display for Measure {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
 impl FromStr for Measure {
     type Err = EvalError;
     fn from_str(s: &str) -> Result<Self> {
-        Self::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
+        Self::from_name(s).ok_or_else(|| {
             EvalError::Invalid(format!("unknown measure '{s}' (mapped_mse, cos_rmse, image_relae)"))
         })
     }

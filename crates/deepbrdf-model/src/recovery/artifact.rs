@@ -22,13 +22,13 @@ use sha2::{Digest, Sha256};
 use super::network::{RecoveryConfig, RecoveryNet};
 use super::step::RecoveryTrained;
 use crate::artifact::{canonical, load_weights, part_of, save_dir, Part};
-use crate::atomic::{read_limited, write_atomic};
+use crate::atomic::{check_format, read_limited, write_atomic, write_manifest};
 use crate::error::{ModelError, Result};
 
 /// File name of the manifest.
 pub const RECOVERY_MANIFEST: &str = "recovery.json";
-/// File name of the weights.
-pub const RECOVERY_WEIGHTS: &str = "weights.bpk";
+/// File name of the weights (the model's, [`crate::artifact::WEIGHTS_FILE`]).
+pub const RECOVERY_WEIGHTS: &str = crate::artifact::WEIGHTS_FILE;
 /// Name of the recovery network's directory beside a model (`models/default/recovery`).
 pub const RECOVERY_DIR: &str = "recovery";
 const FORMAT: &str = "deepbrdf-recovery";
@@ -219,9 +219,7 @@ impl RecoveryArtifact {
             provenance: self.provenance.clone(),
             weights: self.part.clone(),
         };
-        let json = serde_json::to_string_pretty(&manifest)
-            .map_err(|e| ModelError::Invalid(format!("cannot serialise the manifest: {e}")))?;
-        write_atomic(&dir.join(RECOVERY_MANIFEST), &[json.as_bytes(), b"\n"])
+        write_manifest(&dir.join(RECOVERY_MANIFEST), &manifest)
     }
 
     /// Loads a recovery network directory (or the `recovery/` inside a model directory),
@@ -233,15 +231,12 @@ impl RecoveryArtifact {
         let manifest: Manifest = serde_json::from_slice(&text).map_err(|e| {
             ModelError::format(&manifest_path, format!("not a recovery network manifest: {e}"))
         })?;
-        if manifest.format != FORMAT || manifest.version != VERSION {
-            return Err(ModelError::format(
-                &manifest_path,
-                format!(
-                    "format {} version {}, expected {FORMAT} version {VERSION}",
-                    manifest.format, manifest.version
-                ),
-            ));
-        }
+        check_format(
+            &manifest_path,
+            (&manifest.format, manifest.version),
+            FORMAT,
+            VERSION..=VERSION,
+        )?;
         let config: RecoveryConfig =
             serde_json::from_value(manifest.config.clone()).map_err(|e| {
                 ModelError::format(&manifest_path, format!("bad network configuration: {e}"))

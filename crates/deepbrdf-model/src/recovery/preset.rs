@@ -2,7 +2,6 @@
 //! batches of 64, 300 epochs; for a GPU) and `cpu` (64x64 inputs, narrower layers, fewer
 //! epochs: trains in minutes on two cores).
 
-use std::fmt;
 use std::str::FromStr;
 
 use crate::train::{adam, LoopConfig};
@@ -47,29 +46,15 @@ impl RecoveryPreset {
                 .with_checkpoint_seconds(120.0),
         }
     }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Cpu => "cpu",
-            Self::Paper => "paper",
-        }
-    }
 }
 
-impl fmt::Display for RecoveryPreset {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
+deepbrdf_data::named_enum!(RecoveryPreset { Cpu => "cpu", Paper => "paper" });
 
 impl FromStr for RecoveryPreset {
     type Err = String;
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s.trim().to_ascii_lowercase().as_str() {
-            "cpu" => Ok(Self::Cpu),
-            "paper" => Ok(Self::Paper),
-            _ => Err(format!("unknown recovery preset '{s}': expected cpu or paper")),
-        }
+        Self::from_name(s)
+            .ok_or_else(|| format!("unknown recovery preset '{s}': expected cpu or paper"))
     }
 }

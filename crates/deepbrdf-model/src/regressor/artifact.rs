@@ -15,6 +15,7 @@ use sha2::{Digest, Sha256};
 
 use super::network::{NetworkShape, RegressorNet, ATTRIBUTES};
 use super::scaling::{features, Scaling};
+use crate::atomic::check_format;
 use crate::container::Container;
 use crate::error::{ModelError, Result};
 
@@ -210,12 +211,7 @@ impl Regressor {
         let weights = c.take("weights").ok_or_else(|| bad("no weights section".into()))?;
         let manifest: Manifest = serde_json::from_slice(&json)
             .map_err(|e| bad(format!("not a regressor manifest: {e}")))?;
-        if manifest.format != FORMAT || manifest.version != VERSION {
-            return Err(bad(format!(
-                "format {} version {}, expected {FORMAT} version {VERSION}",
-                manifest.format, manifest.version
-            )));
-        }
+        check_format(path, (&manifest.format, manifest.version), FORMAT, VERSION..=VERSION)?;
         if manifest.digest() != manifest.id {
             return Err(ModelError::mismatch(
                 path,

@@ -1,5 +1,5 @@
 //! `experiments edit-known [--model DIR] [--count N] [--seed S] [--out DIR]`: edits measured
-//! against a known answer (issue 33's first goal). Analytic corpus materials
+//! against a known answer. Analytic corpus materials
 //! (`deepbrdf_data::corpus`, drawn with a seed no network was trained on) are edited as a user
 //! would: their 7 attributes fitted, then roughness x0.5 and x2, diffuse and specular albedo x0.5
 //! and a recolour (the diffuse channels rotated) asked of the fit. The answer is the same
@@ -135,12 +135,10 @@ fn answer_is_exact(material: &Material, case: &Case) -> bool {
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let started = Instant::now();
-    let model_dir = args.editor.model.dir()?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let device = crate::device_arg::device()?;
-    let (model, deep_regressor) =
-        editing::load_editor(&model_dir, args.editor.regressor.as_deref(), &device)?;
+    let (model_dir, model, deep_regressor) = args.editor.load(&device)?;
     let k = model.k();
     let fit = FitConfig::default();
 

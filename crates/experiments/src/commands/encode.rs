@@ -9,12 +9,8 @@ use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// [MODEL] MATERIAL: a MERL .binary file or the name of a bundled material; before it, optionally, a trained
-    /// model (the earlier form of `--model DIR`).
-    #[arg(value_name = "[MODEL] MATERIAL", num_args = 1..=2, required = true)]
-    pub inputs: Vec<String>,
     #[command(flatten)]
-    pub model: crate::model_arg::ModelArg,
+    pub input: crate::model_arg::ModelMaterialArg,
     /// Write the latent vector (with the model's id) to this JSON file.
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
@@ -26,7 +22,7 @@ pub struct Args {
 
 pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     let device = crate::device_arg::device()?;
-    let (model_dir, input) = args.model.with_positional(&args.inputs)?;
+    let (model_dir, input) = args.input.resolve()?;
     let model = DeepBrdf::load(&model_dir, &device)?.with_refinement(args.refine.refinement()?);
     let (name, table) = load_material(&input, &args.cache.cache())
         .with_context(|| format!("cannot read {input}"))?;

@@ -9,11 +9,7 @@ use anyhow::{bail, Context};
 use deepbrdf_data::fetch::{
     ChecksumTable, FetchOptions, Fetcher, MERL_BASE_URL, MERL_LEGACY_BASE_URL,
 };
-use deepbrdf_data::Progress;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::IsTerminal;
 use std::path::PathBuf;
-use std::sync::Mutex;
 use std::time::Duration;
 
 #[derive(Debug, clap::Args)]
@@ -61,7 +57,7 @@ pub fn run(args: Args, quiet: bool) -> anyhow::Result<()> {
     options.force = args.force;
 
     let fetcher = Fetcher::new(options);
-    let bars = ByteBars::new(quiet);
+    let bars = crate::progress::Bars::bytes(quiet);
     let report = fetcher
         .fetch(&entries, &bars)
         .with_context(|| format!("fetching MERL files into {}", args.out.display()))?;
@@ -116,61 +112,4 @@ fn seconds(flag: &str, value: f64, zero_ok: bool) -> anyhow::Result<Duration> {
         );
     }
     Ok(Duration::from_secs_f64(value))
-}
-
-/// Progress in bytes (overall, with the current file and its MiB as the status), on stderr;
-/// hidden with `--quiet` or off a terminal.
-struct ByteBars {
-    visible: bool,
-    bar: Mutex<Option<ProgressBar>>,
-}
-
-impl ByteBars {
-    fn new(quiet: bool) -> Self {
-        Self { visible: !quiet && std::io::stderr().is_terminal(), bar: Mutex::new(None) }
-    }
-}
-
-impl Progress for ByteBars {
-    fn start(&self, len: u64, message: &str) {
-        let target =
-            if self.visible { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() };
-        let bar = ProgressBar::with_draw_target(Some(len), target);
-        let style = ProgressStyle::with_template(
-            "{msg:22} [{bar:30}] {bytes}/{total_bytes} {binary_bytes_per_sec} eta {eta} {prefix}",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar())
-        .progress_chars("=> ");
-        bar.set_style(style);
-        bar.set_message(message.to_string());
-        if let Ok(mut slot) = self.bar.lock() {
-            if let Some(old) = slot.replace(bar) {
-                old.finish_and_clear();
-            }
-        }
-    }
-
-    fn advance(&self, n: u64) {
-        if let Ok(slot) = self.bar.lock() {
-            if let Some(bar) = slot.as_ref() {
-                bar.inc(n);
-            }
-        }
-    }
-
-    fn status(&self, status: &str) {
-        if let Ok(slot) = self.bar.lock() {
-            if let Some(bar) = slot.as_ref() {
-                bar.set_prefix(status.to_string());
-            }
-        }
-    }
-
-    fn finish(&self) {
-        if let Ok(mut slot) = self.bar.lock() {
-            if let Some(bar) = slot.take() {
-                bar.finish_and_clear();
-            }
-        }
-    }
 }

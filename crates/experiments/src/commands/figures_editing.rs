@@ -1,5 +1,6 @@
 //! `experiments figures-editing [--model DIR] [--out results/editing] [--every N]`: the
-//! editing figures of §5.1 as PNG strips and the measured suite of issue 11, in-sample (the
+//! editing figures of §5.1 as PNG strips and the measured edit suite
+//! (`deepbrdf_eval::editing::measures`), in-sample (the
 //! model and the regressors saw every material).
 //!
 //! - Fig. 10: red-metallic-paint to red-fabric in 9 steps, DeepBRDF latent vs IPCA coefficients
@@ -163,12 +164,10 @@ fn sweep(
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let started = Instant::now();
-    let model_dir = args.editor.model.dir()?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let device = crate::device_arg::device()?;
-    let (model, deep_regressor) =
-        editing::load_editor(&model_dir, args.editor.regressor.as_deref(), &device)?;
+    let (model_dir, model, deep_regressor) = args.editor.load(&device)?;
     let k = model.k();
     let set = args.data.load(progress)?;
     let fit = FitConfig::default();

@@ -18,6 +18,13 @@ use crate::train::config::{adam, LoopConfig};
 
 /// Everything that determines a training run of the autoencoder. Saved as JSON beside the
 /// checkpoint and in the model's provenance.
+///
+/// The loop's six settings (optimizer to checkpoint interval) are [`LoopConfig`]'s, declared
+/// here again rather than nested, and [`TrainConfig::loop_config`] hands them to the loop: the
+/// file is one flat JSON object (as `models/default/train_config.json` and every checkpoint
+/// hold it), Burn's `Config` derive cannot flatten a nested config into its parent's object,
+/// and the defaults differ (§3.2's here, the shared loop's there). Nesting would change
+/// the file the shipped model was trained from, so the flat layout stays.
 #[derive(Config, Debug)]
 pub struct TrainConfig {
     /// The network.

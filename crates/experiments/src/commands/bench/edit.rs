@@ -37,10 +37,8 @@ pub struct Args {
 
 pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     let device = crate::device_arg::device()?;
-    let model_dir = args.editor.model.dir()?;
     let t = Instant::now();
-    let (model, regressor) =
-        editing::load_editor(&model_dir, args.editor.regressor.as_deref(), &device)?;
+    let (_, model, regressor) = args.editor.load(&device)?;
     let load = t.elapsed().as_secs_f64();
     let (name, table) = load_material(&args.material, &args.cache.cache())
         .with_context(|| format!("loading material '{}'", args.material))?;
