@@ -1,4 +1,4 @@
-//! The kill harness of the reliability tests (issue 15): a long job is SIGKILLed at random
+//! The kill harness of the reliability tests: a long job is SIGKILLed at random
 //! moments and restarted until it finishes, trial after trial, and what each trial leaves must be
 //! byte-identical to what an uninterrupted run left.
 use rand::{Rng, SeedableRng};

@@ -1,4 +1,4 @@
-//! CLI tests of what happens around a run rather than inside it (issue 15): a closed standard
+//! CLI tests of what happens around a run rather than inside it: a closed standard
 //! output, two runs on one output folder, the lock of a killed run, a full disk and a read-only
 //! folder, and the long jobs (`train`, `sweep-k`, `render-set`, `train-recovery`) killed at
 //! random moments ([`kill`]).

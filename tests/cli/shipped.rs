@@ -2,7 +2,10 @@
 //! `decode` and `edit` without `--model` use it, with its editing regressor, and `recover`
 //! uses its recovery network.
 use crate::util;
+use deepbrdf_data::cache::Cache;
+use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::merl::read_merl;
+use deepbrdf_eval::editing::lobe::Lobe;
 use std::path::Path;
 
 use crate::util::s;
@@ -49,6 +52,30 @@ fn the_shipped_model_encodes_decodes_edits_and_recovers_without_model_options() 
     assert!(compare.is_file(), "{}", util::stdout(&out));
 }
 
+#[test]
+fn the_shipped_model_halves_the_diffuse_floor_when_asked_to() {
+    // An edit the shipped model was trained to do, on a material it saw: diffuse albedo x0.5
+    // must lower the diffuse floor (the median luminance away from the highlight,
+    // `deepbrdf_eval::editing::lobe`) and leave the highlight's peak above it.
+    let dir = tempfile::tempdir().unwrap();
+    let material = "red-plastic";
+    let edited = dir.path().join("e.binary");
+    let out =
+        util::run_in(dir.path(), &["edit", material, "--diffuse-scale", "0.5", "-o", &s(&edited)]);
+    assert!(out.status.success(), "{}", util::stderr(&out));
+    let (_, original) = load_material(material, &Cache::disabled()).unwrap();
+    let before = Lobe::of(&original).unwrap();
+    let after = Lobe::of(&read_merl(&edited).unwrap()).unwrap();
+    let ratio = after.floor / before.floor;
+    assert!(
+        (0.2..0.8).contains(&ratio),
+        "diffuse x0.5: floor {:.4e} -> {:.4e} ({ratio:.3}x)",
+        before.floor,
+        after.floor
+    );
+    assert!(after.peak > 0.0, "the highlight is gone: {after:?}");
+}
+
 /// The mapped-space MSE `reconstruct` prints ("...: k = K, mapped-space MSE E; wrote ...").
 fn reconstruction_error(out: &std::process::Output) -> f64 {
     let text = util::stdout(out);
@@ -57,19 +84,28 @@ fn reconstruction_error(out: &std::process::Output) -> f64 {
 }
 
 #[test]
-fn refining_the_encoding_lowers_the_error_of_a_material_the_model_never_saw() {
-    // m2 is synthetic: no model saw it. --refine 0 is the encoder's latent as it is.
+fn refining_the_encoding_never_raises_the_error_and_lowers_it_on_average() {
+    // Synthetic materials no model saw; --refine 0 is the encoder's latent as it is. A
+    // refinement step is kept only when it lowers the mapped error (the error `reconstruct`
+    // prints), so no material may get worse, and on materials outside the training set the
+    // encoder leaves something to gain.
     let dir = tempfile::tempdir().unwrap();
-    let data = util::write_data(dir.path(), 3);
-    let m2 = s(&data.join("m2.binary"));
-    let error = |refine: &str| {
-        let out =
-            util::run_in(dir.path(), &["reconstruct", &m2, "-o", "r.binary", "--refine", refine]);
-        assert!(out.status.success(), "--refine {refine}: {}", util::stderr(&out));
+    let data = util::write_data(dir.path(), 4);
+    let error = |material: &str, refine: &str| {
+        let args = ["reconstruct", material, "-o", "r.binary", "--refine", refine];
+        let out = util::run_in(dir.path(), &args);
+        assert!(out.status.success(), "{args:?}: {}", util::stderr(&out));
         reconstruction_error(&out)
     };
-    let (encoder, refined) = (error("0"), error("20"));
-    assert!(refined.is_finite() && encoder.is_finite());
-    // Measured 2026-12-03: 4.85e-2 vs 4.99e-2 (the rest is outside what the decoder spans).
-    assert!(refined < 0.99 * encoder, "refined {refined:e} vs the encoder's {encoder:e}");
+    let (mut encoder_sum, mut refined_sum) = (0.0, 0.0);
+    for i in 0..4 {
+        let m = s(&data.join(format!("m{i}.binary")));
+        let (encoder, refined) = (error(&m, "0"), error(&m, "20"));
+        assert!(refined.is_finite() && encoder.is_finite(), "m{i}");
+        // The printed error has five significant digits; allow their rounding.
+        assert!(refined <= encoder * (1.0 + 1e-4), "m{i}: refined {refined:e} vs {encoder:e}");
+        encoder_sum += encoder;
+        refined_sum += refined;
+    }
+    assert!(refined_sum < encoder_sum, "refined {refined_sum:e} vs the encoder's {encoder_sum:e}");
 }

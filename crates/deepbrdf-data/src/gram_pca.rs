@@ -15,9 +15,7 @@ use rayon::prelude::*;
 /// Eigenvalues of the Gram matrix at or below this fraction of the largest are treated as zero:
 /// their directions are numerical noise (data of rank r < n leaves n - r of them at round-off
 /// level), so the corresponding directions are left out instead of amplifying noise by
-/// `1/sigma`. (The baselines used 1e-10 and the `cpu` preset 1e-12; no eigenvalue of the bundled
-/// data falls between the two within the k each uses, and 1e-12 keeps the preset's models
-/// unchanged.)
+/// `1/sigma`.
 pub const RELATIVE_EIGEN_FLOOR: f64 = 1e-12;
 
 /// `sum_b part(b)` over `b in 0..blocks` of `n x n` matrices: the parts are computed in parallel

@@ -85,7 +85,7 @@ pub struct StreamedTables {
 impl StreamedTables {
     /// The tables of `collection` through `cache`: every material is tabulated into the cache
     /// first (as loading the collection does) and only the networks are kept; a request reads
-    /// the cache file (17.5 MB, ~0.1 s), tabulating again only if the file has gone. `None`
+    /// the cache file (17.5 MB), tabulating again only if the file has gone. `None`
     /// where the tables cannot be streamed (the measured collection, converted from bundled
     /// files; a disabled cache, or one that did not store a table): load them in memory then.
     pub fn bundled(

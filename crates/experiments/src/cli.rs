@@ -31,7 +31,7 @@ pub enum Command {
     Folds(commands::folds::Args),
     /// Write MERL .binary files tabulated from the bundled NBRDF networks.
     Tabulate(commands::tabulate::Args),
-    /// Write a corpus of analytic materials with known parameters (issue 33): the parameter
+    /// Write a corpus of analytic materials with known parameters: the parameter
     /// file and, with --tables K, the first K materials as MERL .binary files.
     Corpus(commands::corpus::Args),
     /// Pack folders of JSON NBRDF networks into the bundled .nbrdf files.

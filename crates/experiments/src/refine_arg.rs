@@ -1,7 +1,7 @@
 //! The `--refine N` and `--refine-radiance P` options of the commands that encode with a
 //! `slice` model (`encode`, `reconstruct`, `baselines`, `sweep-k`): how many Levenberg-Marquardt
 //! steps refine each encoding through the decoder, and on which error
-//! (`deepbrdf_model::refine`, issue 13).
+//! (`deepbrdf_model::refine`).
 use anyhow::bail;
 use deepbrdf_model::refine::Refinement;
 

@@ -1,5 +1,5 @@
-//! A corpus of physically based analytic materials with known parameters (issue 33: a training
-//! set that covers the space of materials between and beyond the measured ones, with the
+//! A corpus of physically based analytic materials with known parameters (a training set
+//! that covers the space of materials between and beyond the measured ones, with the
 //! answers of edits known): the models ([`diffuse`], [`microfacet`], [`fresnel`],
 //! [`conductors`], [`sheen`], [`retro`], [`coat`]), the [`material`] description with its
 //! known [`attributes`] and edits, the [`sampler`], tabulation on the MERL grid ([`tabulate`],

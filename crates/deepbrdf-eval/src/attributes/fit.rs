@@ -21,7 +21,8 @@ use deepbrdf_render::geometry::Vec3;
 use deepbrdf_render::{Brdf, Ggx};
 use rayon::prelude::*;
 
-/// Settings of [`fit`]. The default fits a MERL table in ~0.5 s on 2 cores (~35,000 cells).
+/// Settings of [`fit`]. The default samples ~35,000 cells of a MERL table (docs/performance.md
+/// has its time).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FitConfig {
     /// Every theta_d index that is a multiple of this is sampled (all 90 theta_h indices are:

@@ -1,4 +1,4 @@
-//! Measures of edits, interpolations and sweeps (issue 11, beyond the paper, which only shows
+//! Measures of edits, interpolations and sweeps (beyond the paper, which only shows
 //! pictures): how close an edit's re-estimated attributes come to the requested ones and how
 //! much the untouched ones drift (leakage); the coefficient of variation of consecutive image
 //! differences along a path; the monotonicity of a sweep; and the physical plausibility of a

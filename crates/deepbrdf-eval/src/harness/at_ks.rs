@@ -1,6 +1,6 @@
 //! A [`Method`] restricted to some of the harness's k: the cheap baselines sweep every k while
 //! a method that trains a network per fold and k (DeepBRDF) runs at the few that matter
-//! (`experiments sweep-k --deep-ks`, issue 13: the default held-out sweep within 30 minutes).
+//! (`experiments sweep-k --deep-ks`: a network per fold and k is the sweep's costly part).
 
 use super::codec::{Codec, FoldTraining, Method};
 use crate::error::Result;

@@ -101,7 +101,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         bail!("the ggx method has exactly 7 parameters: run it with --k 7");
     }
     let out = args.out.clone().unwrap_or_else(|| default_out(args.mode));
-    // Held until the run ends: a second run on the same folder is refused (issue 15).
+    // Held until the run ends: a second run on the same folder is refused.
     let _lock = deepbrdf_data::lock::FolderLock::acquire(&out)?;
     // Refuse before any work, so a long run never ends by refusing to write.
     check_not_overwriting(&out, &RESULT_FILES, args.force, "results of an earlier run")?;

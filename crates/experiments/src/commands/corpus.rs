@@ -1,5 +1,5 @@
 //! `experiments corpus`: writes a corpus of analytic materials with known parameters
-//! (`deepbrdf_data::corpus`, issue 33): the parameter file `DIR/corpus.jsonl` (seed, count, one
+//! (`deepbrdf_data::corpus`): the parameter file `DIR/corpus.jsonl` (seed, count, one
 //! JSON record a material; tables are regenerated from it bit for bit) and, with `--tables K`,
 //! the first K materials tabulated as MERL `.binary` files under `DIR/tables`. Prints the file's
 //! size per material and the tabulation speed on this machine. Existing files are replaced only

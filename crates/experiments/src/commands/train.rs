@@ -112,7 +112,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let device = crate::device_arg::device()?;
     let kind = crate::device_arg::kind()?;
     let resume_dir = args.resume.clone().map(|d| d.or_else(|| args.out.clone()));
-    // Held until the run ends: a second run on the same folder is refused (issue 15).
+    // Held until the run ends: a second run on the same folder is refused.
     let lock: FolderLock;
     let (out, config, resume) = match resume_dir {
         Some(None) => bail!("--resume needs a directory (--resume DIR or --out DIR --resume)"),

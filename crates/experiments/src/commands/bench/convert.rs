@@ -1,5 +1,5 @@
 //! `experiments bench convert`: times converting RGL measurements (`.bsdf`) to the MERL grid,
-//! no cache (issue 10 target: at most 10 s per file on 2 cores). Default: the seven bundled
+//! no cache (target: at most 10 s per file on 2 cores). Default: the seven bundled
 //! `rgl-measured` files.
 use deepbrdf_data::rgl::{bundled, tabulate, RglBrdf};
 use deepbrdf_data::Progress;

@@ -1,4 +1,4 @@
-//! `experiments bench io`: times reading and writing MERL `.binary` files (issue 2: reading a
+//! `experiments bench io`: times reading and writing MERL `.binary` files (target: reading a
 //! 34,992,012-byte file must take well under 0.5 s).
 use anyhow::Context;
 use deepbrdf_data::merl::io::FILE_BYTES;

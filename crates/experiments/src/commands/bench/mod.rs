@@ -41,7 +41,7 @@ pub enum What {
     /// One edit of §5.1: regressor, decode and a 128-pixel preview (target: <= 0.5 s on 2 cores).
     Edit(edit::Args),
     /// Renderer efficiency at equal noise: seconds per image, relative noise between two seeds
-    /// and 1 / (noise^2 x s), per material and light (issue 16).
+    /// and 1 / (noise^2 x s), per material and light.
     RenderNoise(render_noise::Args),
     /// Images per second of the recovery render set (§5.2) at its CPU default.
     RenderSet(render_set::Args),

@@ -1,6 +1,6 @@
 //! `experiments bench model`: training seconds per BRDF for the presets (and their ratio), and
 //! the time to decode a latent vector into a full MERL table next to IPCA's decode of k
-//! coefficients (issue 13's targets: DeepBRDF at most 1.0 x IPCA and at most 0.15 s on 2 cores;
+//! coefficients (targets: DeepBRDF at most 1.0 x IPCA and at most 0.15 s on 2 cores;
 //! the paper reports 0.3 s for DeepBRDF on a GPU and 0.15 s for IPCA, 2.0 x). All measured in
 //! the same run, the networks on the `--device` backend.
 use deepbrdf_data::testing::synthetic_set;

@@ -1,4 +1,4 @@
-//! `experiments bench recover`: seconds of one `recover` (issue 12 target: network + decode at
+//! `experiments bench recover`: seconds of one `recover` (target: network + decode at
 //! most 0.5 s on 2 cores): reading and preparing the photo, the recovery CNN, and DeepBRDF's
 //! decode of its latent (eq. 3), each the median of `--repeats` runs after a warm-up.
 use crate::model_arg::ModelArg;

@@ -1,4 +1,4 @@
-//! `experiments bench render`: speed of the renderer (issue 3 target: a 256 x 256 sphere of a
+//! `experiments bench render`: speed of the renderer (target: a 256 x 256 sphere of a
 //! tabulated MERL material under sun and sky at 64 spp in under 0.5 s on 2 cores). Prints MERL
 //! lookups per second, images per second, and the cost of the tabulated material relative to an
 //! analytic one measured in the same run.

@@ -1,4 +1,4 @@
-//! `experiments bench render-noise`: the renderer's efficiency at equal noise (issue 16). For a
+//! `experiments bench render-noise`: the renderer's efficiency at equal noise. For a
 //! Lambertian, an analytic Lambertian + GGX plastic and measured materials, under sun and sky and
 //! under a constant environment, prints seconds per image, the relative noise (standard deviation
 //! over fully covered pixels of the difference of two seeds' renders, divided by sqrt(2) and by

@@ -1,5 +1,5 @@
 //! `experiments bench tabulate`: times tabulating bundled NBRDF networks onto the MERL grid, with
-//! no cache (issue 2 target: all 100 `merl` materials in under 30 s on 2 cores).
+//! no cache (target: all 100 `merl` materials in under 30 s on 2 cores).
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::nbrdf::tabulate;
 use deepbrdf_data::Progress;
