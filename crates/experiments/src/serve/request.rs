@@ -215,16 +215,17 @@ impl EditRequest {
                 Some((b.material.clone(), b.t))
             }
         };
-        let mode =
-            match self.mode.as_deref() {
-                None => DEFAULT_MODE,
-                Some(name) => match name.parse::<EditMode>().map_err(|e| bad(e.to_string()))? {
-                    m if EditMode::LATENT.contains(&m) => m,
-                    m => return Err(bad(format!(
+        let mode = match self.mode.as_deref() {
+            None => DEFAULT_MODE,
+            Some(name) => match name.parse::<EditMode>().map_err(|e| bad(e.to_string()))? {
+                m if EditMode::LATENT.contains(&m) => m,
+                m => {
+                    return Err(bad(format!(
                         "the editor edits latents: mode {m} is not one of them (paper, residual)"
-                    ))),
-                },
-            };
+                    )))
+                }
+            },
+        };
         let edit = Edit {
             diffuse: self.diffuse.map(ColourEdit::Set),
             specular: self.specular.map(ColourEdit::Set),
