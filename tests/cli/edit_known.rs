@@ -1,6 +1,6 @@
 //! `train --corpus`, `train-regressor --corpus` and `edit-known` end to end with a tiny model on
 //! three synthetic materials and a few corpus materials: the corpus materials join the training
-//! set, and every known-answer edit is scored for each of the four methods, the analytic edit
+//! set, and every known-answer edit is scored for each of the seven methods, the analytic edit
 //! ending nearer the answer than the unedited material.
 use crate::util::{self, s};
 
@@ -60,13 +60,25 @@ fn corpus_training_and_known_answer_edits() {
         "7",
         "--out",
         &s(&out),
+        "--methods",
+        "analytic,deepbrdf-residual,deepbrdf-paper,ipca-residual,deepbrdf-transfer,deepbrdf-transfer-paper,ipca-transfer",
     ]);
     assert!(printed.contains("| analytic | **all** |"), "{printed}");
     let csv = std::fs::read_to_string(out.join("known.csv")).unwrap();
     let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
-    assert!(!rows.is_empty() && rows.len() % 4 == 0, "{csv}");
-    for method in ["analytic", "DeepBRDF residual", "DeepBRDF paper", "IPCA residual"] {
-        assert_eq!(rows.iter().filter(|r| r[2] == method).count(), rows.len() / 4, "{csv}");
+    let methods = [
+        "analytic",
+        "DeepBRDF residual",
+        "DeepBRDF paper",
+        "IPCA residual",
+        "DeepBRDF transfer",
+        "DeepBRDF transfer (paper)",
+        "IPCA transfer",
+    ];
+    assert!(!rows.is_empty() && rows.len() % methods.len() == 0, "{csv}");
+    for method in methods {
+        let count = rows.iter().filter(|r| r[2] == method).count();
+        assert_eq!(count, rows.len() / methods.len(), "{csv}");
     }
     // The analytic edit of an analytic material moves towards the answer.
     assert!(rows.iter().filter(|r| r[2] == "analytic").all(|r| r[7] == "false"), "{csv}");

@@ -32,10 +32,13 @@ pub struct EditorArg {
 /// Name of the folder holding a model's regressors, inside the model directory.
 pub const REGRESSOR_DIR: &str = "regressor";
 
-/// The `--mode` option's parser: `paper` or `residual` ([`EditMode`]).
-pub fn mode_parser() -> impl clap::builder::TypedValueParser<Value = EditMode> {
+/// The `--mode` option's parser for `modes` ([`EditMode::ALL`], or [`EditMode::LATENT`] where the
+/// edit has to be a latent).
+pub fn mode_parser(
+    modes: &'static [EditMode],
+) -> impl clap::builder::TypedValueParser<Value = EditMode> {
     use clap::builder::TypedValueParser as _;
-    clap::builder::PossibleValuesParser::new(EditMode::ALL.map(EditMode::name))
+    clap::builder::PossibleValuesParser::new(modes.iter().map(|m| m.name()))
         .map(|s| s.parse().expect("a listed edit mode parses"))
 }
 

@@ -28,7 +28,14 @@ pub fn analytic_edit(
     if fitted == requested {
         return Ok(table.clone());
     }
-    let (before, after) = (fitted.table(), requested.table());
+    carry_edit(table, &fitted.table(), &requested.table())
+}
+
+/// The change from the model `before` to the model `after` carried onto `table` by the rule of
+/// the module's documentation: `T - M + M'` where `T >= M`, `M' T / M` below. The analytic edit
+/// takes the fitted analytic model at the two attribute vectors; the transfer edit
+/// ([`crate::editing::Space::transfer`]) a representation's decoded tables.
+pub fn carry_edit(table: &MerlTable, before: &MerlTable, after: &MerlTable) -> Result<MerlTable> {
     let values: Vec<f32> = table
         .values()
         .iter()
@@ -40,7 +47,7 @@ pub fn analytic_edit(
         })
         .collect();
     MerlTable::from_values(values)
-        .map_err(|e| EvalError::Invalid(format!("analytic edit: the edited table: {e}")))
+        .map_err(|e| EvalError::Invalid(format!("carrying an edit: the edited table: {e}")))
 }
 
 /// One value of the edit: table `t`, model `m` before and `m_new` after (all >= 0).
@@ -96,5 +103,13 @@ mod tests {
         // The branches meet at t = m.
         assert_eq!(edit_value(4.0, 4.0, 2.0), 2.0);
         assert!((edit_value(4.0 - 1e-9, 4.0, 2.0) - 2.0).abs() < 1e-8);
+    }
+
+    #[test]
+    fn carrying_onto_the_model_itself_gives_the_new_model() {
+        let (before, after) = (attributes(0.1).table(), attributes(0.3).table());
+        assert_eq!(carry_edit(&before, &before, &after).unwrap().values(), after.values());
+        let table = attributes(0.05).table();
+        assert_eq!(carry_edit(&table, &before, &before).unwrap().values(), table.values());
     }
 }

@@ -18,7 +18,7 @@ pub mod measures;
 pub mod request;
 pub mod space;
 
-pub use analytic::analytic_edit;
+pub use analytic::{analytic_edit, carry_edit};
 pub use known::{KnownEdit, KnownTally};
 pub use lobe::{
     compare, dark_hole, judge_edit, verdict, BarCount, EditLobe, Lobe, LobeBar, LobeComparison,

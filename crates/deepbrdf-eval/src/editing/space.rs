@@ -5,7 +5,7 @@
 //! path, two tables).
 
 use crate::attributes::Attributes;
-use crate::editing::Edit;
+use crate::editing::{analytic_edit, carry_edit, Edit};
 use crate::error::{EvalError, Result};
 use crate::harness::Codec;
 use deepbrdf_data::merl::INVALID_VALUE;
@@ -22,18 +22,38 @@ pub enum EditMode {
     Paper,
     /// Keeps what the attributes do not explain: `Y' = Y + Phi(alpha') - Phi(alpha)`.
     Residual,
+    /// The residual edit's change `D(Y) -> D(Y')` carried onto the table itself
+    /// ([`Space::transfer`]): what the representation does not reconstruct is kept.
+    Transfer,
+    /// The analytic edit, no network ([`crate::editing::analytic_edit`]).
+    Analytic,
 }
 
 impl EditMode {
-    /// Both modes.
-    pub const ALL: [EditMode; 2] = [EditMode::Paper, EditMode::Residual];
+    /// Every mode.
+    pub const ALL: [EditMode; 4] =
+        [EditMode::Paper, EditMode::Residual, EditMode::Transfer, EditMode::Analytic];
+    /// The modes whose result is a latent, decoded as it is (the browser editor's).
+    pub const LATENT: [EditMode; 2] = [EditMode::Paper, EditMode::Residual];
 
     /// The mode's name on the command line and in results.
     pub fn name(self) -> &'static str {
         match self {
             Self::Paper => "paper",
             Self::Residual => "residual",
+            Self::Transfer => "transfer",
+            Self::Analytic => "analytic",
         }
+    }
+
+    /// Whether the edit needs the table's latent (its encoding).
+    pub fn needs_latent(self) -> bool {
+        matches!(self, Self::Residual | Self::Transfer)
+    }
+
+    /// Whether the edit goes through a representation and its regressor.
+    pub fn needs_network(self) -> bool {
+        self != Self::Analytic
     }
 }
 
@@ -48,7 +68,8 @@ impl FromStr for EditMode {
 
     fn from_str(s: &str) -> Result<Self> {
         Self::ALL.into_iter().find(|m| m.name() == s.trim()).ok_or_else(|| {
-            EvalError::Invalid(format!("edit mode {s:?}: expected paper or residual"))
+            let names: Vec<&str> = Self::ALL.iter().map(|m| m.name()).collect();
+            EvalError::Invalid(format!("edit mode {s:?}: expected one of {}", names.join(", ")))
         })
     }
 }
@@ -100,23 +121,57 @@ impl Space<'_> {
             .map_err(|e| EvalError::method(format!("{} regressor", self.codec.name()), e))
     }
 
-    /// Edits `table`, whose attributes are `original` (and latent `latent`, for the residual
-    /// edit), by `edit` in `mode`.
+    /// Edits `table`, whose attributes are `original` (and latent `latent`, which the residual
+    /// and transfer edits need), by `edit` in `mode`.
     pub fn edit(
         &self,
+        table: &MerlTable,
         latent: &[f32],
         original: &Attributes,
         edit: &Edit,
         mode: EditMode,
     ) -> Result<Edited> {
         let requested = edit.apply(original)?;
-        let latent = self.edited_latent(latent, original, &requested, mode)?;
-        let table = self.codec.decode(&latent)?;
+        let table = match mode {
+            EditMode::Paper | EditMode::Residual => {
+                self.codec.decode(&self.edited_latent(latent, original, &requested, mode)?)?
+            }
+            EditMode::Transfer => return self.transfer(table, latent, original, edit, mode),
+            EditMode::Analytic => analytic_edit(table, original, &requested)?,
+        };
+        Ok(Edited { requested, table })
+    }
+
+    /// The transfer edit: the representation's change carried onto `table` itself
+    /// ([`carry_edit`]) instead of replacing the table by a decoded one. With `mode` paper it
+    /// carries the change from `D(Phi(alpha))` to `D(Phi(alpha'))`; otherwise the residual
+    /// edit's, from the table's reconstruction `D(Y)` to `D(Y')`. What the representation does not
+    /// reconstruct of the unedited table is kept, as the analytic edit keeps what its model does
+    /// not explain.
+    pub fn transfer(
+        &self,
+        table: &MerlTable,
+        latent: &[f32],
+        original: &Attributes,
+        edit: &Edit,
+        mode: EditMode,
+    ) -> Result<Edited> {
+        let requested = edit.apply(original)?;
+        if requested == *original {
+            return Ok(Edited { requested, table: table.clone() });
+        }
+        let (before, mode) = match mode {
+            EditMode::Paper => (self.codec.decode(&self.latent_of(original)?)?, EditMode::Paper),
+            _ => (self.codec.decode(latent)?, EditMode::Residual),
+        };
+        let after = self.codec.decode(&self.edited_latent(latent, original, &requested, mode)?)?;
+        let table = carry_edit(table, &before, &after)?;
         Ok(Edited { requested, table })
     }
 
     /// The latent of the edit from `original` (latent `latent`, used by the residual edit) to
-    /// the attributes `requested` (checked by [`Edit::apply`]), before decoding.
+    /// the attributes `requested` (checked by [`Edit::apply`]), before decoding. The transfer
+    /// edit's latent is the residual edit's; the analytic edit has none (an error).
     pub fn edited_latent(
         &self,
         latent: &[f32],
@@ -127,7 +182,10 @@ impl Space<'_> {
         let target = self.latent_of(requested)?;
         Ok(match mode {
             EditMode::Paper => target,
-            EditMode::Residual => {
+            EditMode::Analytic => {
+                return Err(EvalError::Invalid("the analytic edit has no latent".into()));
+            }
+            EditMode::Residual | EditMode::Transfer => {
                 let base = self.latent_of(original)?;
                 latent.iter().zip(target.iter().zip(&base)).map(|(y, (t, b))| y + t - b).collect()
             }
@@ -165,7 +223,9 @@ mod tests {
         for m in EditMode::ALL {
             assert_eq!(m.name().parse::<EditMode>().unwrap(), m);
         }
-        assert!("linear".parse::<EditMode>().unwrap_err().to_string().contains("paper"));
+        assert!("linear".parse::<EditMode>().unwrap_err().to_string().contains("analytic"));
+        assert!(EditMode::LATENT.iter().all(|m| m.needs_network()));
+        assert!(!EditMode::Analytic.needs_network() && !EditMode::Paper.needs_latent());
     }
 
     #[test]

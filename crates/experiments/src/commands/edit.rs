@@ -1,8 +1,9 @@
 //! `experiments edit [--model DIR] MATERIAL [--diffuse R,G,B | --diffuse-scale X] [--specular
-//! R,G,B | --specular-scale X] [--roughness X | --roughness-scale X] [--mode paper|residual]
-//! -o edited.binary [--render edited.png]`: edits a material's diffuse albedo, specular albedo or
-//! roughness (§5.1) through the model's regressor (eq. 7) and decoder (eq. 3), writes the
-//! edited MERL table, and prints the attributes asked for and those re-estimated on the result.
+//! R,G,B | --specular-scale X] [--roughness X | --roughness-scale X]
+//! [--mode paper|residual|transfer|analytic] -o edited.binary [--render edited.png]`: edits a
+//! material's diffuse albedo, specular albedo or roughness (§5.1) through the model's regressor
+//! (eq. 7) and decoder (eq. 3), or analytically without a network, writes the edited MERL
+//! table, and prints the attributes asked for and those re-estimated on the result.
 use crate::data_args::CacheArg;
 use crate::editing::{self, EditMode, EditorArg, ModelCodec, Space, DEFAULT_MODE};
 use crate::scene_args::SceneArgs;
@@ -11,6 +12,7 @@ use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::merl::write_merl;
 use deepbrdf_data::Progress;
 use deepbrdf_eval::attributes::{Attributes, FitConfig};
+use deepbrdf_eval::editing::{analytic_edit, Edited};
 use deepbrdf_eval::editing::{ColourEdit, Edit, ScalarEdit};
 use deepbrdf_render::{render, MerlBrdf};
 use std::path::PathBuf;
@@ -24,8 +26,10 @@ pub struct Args {
     pub material: String,
     #[command(flatten)]
     pub edit: EditArgs,
-    /// paper: Y' = Phi(alpha'); residual: Y' = Y + Phi(alpha') - Phi(alpha) [default: residual].
-    #[arg(long, value_parser = editing::mode_parser())]
+    /// paper: Y' = Phi(alpha'); residual: Y' = Y + Phi(alpha') - Phi(alpha); transfer: the
+    /// residual edit's change carried onto the table itself; analytic: the table's fitted
+    /// Lambertian + GGX model swapped for the edited one, no network [default: residual].
+    #[arg(long, value_parser = editing::mode_parser(&EditMode::ALL))]
     pub mode: Option<EditMode>,
     /// Output MERL .binary file.
     #[arg(short, long, value_name = "FILE")]
@@ -130,21 +134,30 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let original = editing::attributes_of(&table, &name, &fit)?;
     // Checked before the model loads: a bad value fails at once.
     edit.apply(&original).with_context(|| format!("editing {name}"))?;
-    let device = crate::device_arg::device()?;
-    let model_dir = args.editor.model.dir()?;
-    let (model, regressor) =
-        editing::load_editor(&model_dir, args.editor.regressor.as_deref(), &device)?;
-    let codec = ModelCodec(&model);
-    let space = Space { codec: &codec, regressor: &regressor };
     let mode = args.mode.unwrap_or(DEFAULT_MODE);
-    let latent = match mode {
-        EditMode::Residual => model.encode(&table)?,
-        EditMode::Paper => Vec::new(),
+    let (edited, by) = match mode.needs_network() {
+        false => {
+            let requested = edit.apply(&original)?;
+            let table = analytic_edit(&table, &original, &requested)?;
+            (Edited { requested, table }, "no network".to_string())
+        }
+        true => {
+            let device = crate::device_arg::device()?;
+            let model_dir = args.editor.model.dir()?;
+            let (model, regressor) =
+                editing::load_editor(&model_dir, args.editor.regressor.as_deref(), &device)?;
+            let codec = ModelCodec(&model);
+            let space = Space { codec: &codec, regressor: &regressor };
+            let latent = match mode.needs_latent() {
+                true => model.encode(&table)?,
+                false => Vec::new(),
+            };
+            (space.edit(&table, &latent, &original, &edit, mode)?, format!("model {}", model.id()))
+        }
     };
-    let edited = space.edit(&latent, &original, &edit, mode)?;
     write_merl(&edited.table, &args.output)?;
     let achieved = editing::attributes_of(&edited.table, "the edited table", &fit)?;
-    println!("{name} (model {}, {} edit)", model.id(), mode.name());
+    println!("{name} ({by}, {} edit)", mode.name());
     println!("  original  {}", describe(&original));
     println!("  requested {}", describe(&edited.requested));
     println!("  achieved  {} (re-estimated on the result)", describe(&achieved));

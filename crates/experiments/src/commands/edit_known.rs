@@ -16,7 +16,7 @@ use deepbrdf_data::corpus::{self, Material};
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::attributes::{Attributes, FitConfig};
 use deepbrdf_eval::editing::known::{self, KnownEdit};
-use deepbrdf_eval::editing::{analytic_edit, judge_edit, ColourEdit, Edit, Lobe, ScalarEdit};
+use deepbrdf_eval::editing::{judge_edit, ColourEdit, Edit, Lobe, ScalarEdit};
 use deepbrdf_eval::metrics::ImageRelaeConfig;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -64,9 +64,30 @@ pub enum Method {
     DeepbrdfPaper,
     /// IPCA's residual edit.
     IpcaResidual,
+    /// DeepBRDF's residual edit carried onto the table (`Space::transfer`).
+    DeepbrdfTransfer,
+    /// DeepBRDF's edit of the paper carried onto the table (`Space::transfer`).
+    DeepbrdfTransferPaper,
+    /// IPCA's residual edit carried onto the table.
+    IpcaTransfer,
 }
 
 impl Method {
+    /// Whether the method edits through IPCA (else DeepBRDF, or no network).
+    fn ipca(self) -> bool {
+        matches!(self, Self::IpcaResidual | Self::IpcaTransfer)
+    }
+
+    /// The method's edit mode.
+    fn mode(self) -> EditMode {
+        match self {
+            Self::Analytic => EditMode::Analytic,
+            Self::DeepbrdfResidual | Self::IpcaResidual => EditMode::Residual,
+            Self::DeepbrdfPaper | Self::DeepbrdfTransferPaper => EditMode::Paper,
+            Self::DeepbrdfTransfer | Self::IpcaTransfer => EditMode::Transfer,
+        }
+    }
+
     /// The method's name in the results.
     fn label(self) -> &'static str {
         match self {
@@ -74,6 +95,9 @@ impl Method {
             Self::DeepbrdfResidual => "DeepBRDF residual",
             Self::DeepbrdfPaper => "DeepBRDF paper",
             Self::IpcaResidual => "IPCA residual",
+            Self::DeepbrdfTransfer => "DeepBRDF transfer",
+            Self::DeepbrdfTransferPaper => "DeepBRDF transfer (paper)",
+            Self::IpcaTransfer => "IPCA transfer",
         }
     }
 }
@@ -143,25 +167,27 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let fit = FitConfig::default();
 
     // IPCA at the model's k on the training materials, with its regressor, when asked for.
-    let ipca = match args.methods.contains(&Method::IpcaResidual) {
-        true => {
-            let set = args.data.load(progress)?;
-            let attrs = editing::attributes_of_all(&set, &fit, progress)?;
-            let reg_dir = editing::regressor_dir(&model_dir, args.editor.regressor.as_deref());
-            let scratch = args.out.join("ipca-regressor");
-            Some(editing::ipca_editor(
-                &reg_dir,
-                &set,
-                &attrs,
-                k,
-                args.epochs,
-                &scratch,
-                progress,
-                &device,
-            )?)
-        }
-        false => None,
-    };
+    let ipca =
+        match args.methods.iter().any(|m| matches!(m, Method::IpcaResidual | Method::IpcaTransfer))
+        {
+            true => {
+                let set = args.data.load(progress)?;
+                let attrs = editing::attributes_of_all(&set, &fit, progress)?;
+                let reg_dir = editing::regressor_dir(&model_dir, args.editor.regressor.as_deref());
+                let scratch = args.out.join("ipca-regressor");
+                Some(editing::ipca_editor(
+                    &reg_dir,
+                    &set,
+                    &attrs,
+                    k,
+                    args.epochs,
+                    &scratch,
+                    progress,
+                    &device,
+                )?)
+            }
+            false => None,
+        };
     let deep_codec = ModelCodec(&model);
     let deep = Space { codec: &deep_codec, regressor: &deep_regressor };
     let ipca_space = ipca.as_ref().map(|(codec, regressor)| Space { codec, regressor });
@@ -179,30 +205,27 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         let ipca_latent = ipca_space.as_ref().map(|s| s.codec.encode(&table)).transpose()?;
         let lobe = Lobe::of(&table).ok();
         for case in cases(&material, &fitted) {
-            let Ok(requested) = case.edit.apply(&fitted) else {
-                skipped += 1;
-                continue;
-            };
-            if !answer_is_exact(&material, &case) {
+            if case.edit.apply(&fitted).is_err() || !answer_is_exact(&material, &case) {
                 skipped += 1;
                 continue;
             }
             let answer =
                 case.answer.table().with_context(|| format!("tabulating {name} {}", case.name))?;
             let edit_by = |method: Method| -> anyhow::Result<MerlTable> {
-                let deep_edit = |mode| deep.edit(&deep_latent, &fitted, &case.edit, mode);
+                let (space, latent) = match method.ipca() {
+                    false => (&deep, &deep_latent),
+                    true => ipca_space
+                        .as_ref()
+                        .zip(ipca_latent.as_ref())
+                        .context("IPCA was not loaded")?,
+                };
                 Ok(match method {
-                    Method::Analytic => analytic_edit(&table, &fitted, &requested)?,
-                    Method::DeepbrdfResidual => deep_edit(EditMode::Residual)?.table,
-                    Method::DeepbrdfPaper => deep_edit(EditMode::Paper)?.table,
-                    Method::IpcaResidual => {
-                        let (space, latent) = ipca_space
-                            .as_ref()
-                            .zip(ipca_latent.as_ref())
-                            .context("IPCA was not loaded")?;
-                        space.edit(latent, &fitted, &case.edit, EditMode::Residual)?.table
+                    Method::DeepbrdfTransferPaper => {
+                        space.transfer(&table, latent, &fitted, &case.edit, EditMode::Paper)?
                     }
-                })
+                    _ => space.edit(&table, latent, &fitted, &case.edit, method.mode())?,
+                }
+                .table)
             };
             let candidates = args
                 .methods

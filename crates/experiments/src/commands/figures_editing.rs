@@ -10,8 +10,8 @@
 //! - Fig. 14: the same sweep of specular-yellow-phenolic, DeepBRDF vs IPCA.
 //! - The suite, on every N-th material: diffuse albedo x0.5 and a hue change (its channels
 //!   rotated), specular albedo x0.5, roughness x0.5 and x2, and the identity edit, for DeepBRDF
-//!   and IPCA (at the model's k), paper and residual edits, and the analytic edit without a
-//!   network (`deepbrdf_eval::editing::analytic`): the attributes re-estimated on each
+//!   and IPCA (at the model's k), paper and residual edits and the residual edit carried onto
+//!   the table (transfer), and the analytic edit without a network (`deepbrdf_eval::editing::analytic`): the attributes re-estimated on each
 //!   decoded table against the requested ones (target error, change ratio, drift of the
 //!   untouched attributes), the identity edit's image RelAE against the original, the
 //!   plausibility of every decoded table; the specular lobe read off each decoded table against
@@ -135,12 +135,15 @@ fn lobe_summary(rows: &[SuiteRow]) -> String {
 }
 
 /// The suite's (representation, mode) pairs, in the order of its tables: each representation's
-/// paper and residual edits, and the analytic edit without a network.
-const SUITE_METHODS: [(&str, &str); 5] = [
+/// paper and residual edits and the residual edit carried onto the table (`Space::transfer`),
+/// and the analytic edit without a network.
+const SUITE_METHODS: [(&str, &str); 7] = [
     ("DeepBRDF", "paper"),
     ("DeepBRDF", "residual"),
+    ("DeepBRDF", "transfer"),
     ("IPCA", "paper"),
     ("IPCA", "residual"),
+    ("IPCA", "transfer"),
     ("analytic", "-"),
 ];
 
@@ -159,7 +162,7 @@ fn sweep(
     mode: EditMode,
 ) -> anyhow::Result<Vec<MerlTable>> {
     let latent = rep.space.codec.encode(table)?;
-    edits.iter().map(|e| Ok(rep.space.edit(&latent, original, e, mode)?.table)).collect()
+    edits.iter().map(|e| Ok(rep.space.edit(table, &latent, original, e, mode)?.table)).collect()
 }
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
@@ -380,9 +383,9 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         };
         for rep in reps {
             let latent = rep.space.codec.encode(table)?;
-            for mode in [EditMode::Paper, EditMode::Residual] {
+            for mode in [EditMode::Paper, EditMode::Residual, EditMode::Transfer] {
                 for (edit_name, edit) in suite_edits(original) {
-                    let Ok(edited) = rep.space.edit(&latent, original, &edit, mode) else {
+                    let Ok(edited) = rep.space.edit(table, &latent, original, &edit, mode) else {
                         continue; // an edit out of range for this material (e.g. x2 past alpha 1)
                     };
                     push(

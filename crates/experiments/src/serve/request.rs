@@ -217,7 +217,14 @@ impl EditRequest {
         };
         let mode = match self.mode.as_deref() {
             None => DEFAULT_MODE,
-            Some(name) => name.parse::<EditMode>().map_err(|e| bad(e.to_string()))?,
+            Some(name) => match name.parse::<EditMode>().map_err(|e| bad(e.to_string()))? {
+                m if EditMode::LATENT.contains(&m) => m,
+                m => {
+                    return Err(bad(format!(
+                        "the editor edits latents: mode {m} is not one of them (paper, residual)"
+                    )))
+                }
+            },
         };
         let edit = Edit {
             diffuse: self.diffuse.map(ColourEdit::Set),

@@ -26,7 +26,7 @@ pub struct Args {
     pub material: String,
     #[command(flatten)]
     pub edit: EditArgs,
-    #[arg(long, value_parser = editing::mode_parser())]
+    #[arg(long, value_parser = editing::mode_parser(&EditMode::LATENT))]
     pub mode: Option<EditMode>,
     /// Timed edits (after one warm-up).
     #[arg(long, default_value_t = 5)]
