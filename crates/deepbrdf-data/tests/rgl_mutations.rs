@@ -40,7 +40,9 @@ fn header_fields(b: &[u8]) -> Vec<(usize, usize)> {
     out
 }
 
-/// The seed files: the bundled measurements, then the writer's exports.
+/// The seed files: the bundled measurements, then the writer's exports. Building them uses rayon:
+/// call it first on the test's own thread, never first from a rayon worker (whose pool the
+/// build would then wait for).
 fn corpus() -> &'static [(String, Vec<u8>)] {
     static CORPUS: OnceLock<Vec<(String, Vec<u8>)>> = OnceLock::new();
     CORPUS.get_or_init(|| {
@@ -167,6 +169,7 @@ fn exported_files_parse_unmutated() {
 
 #[test]
 fn mutated_real_files_never_panic() {
+    corpus();
     let cases: usize = std::env::var("DEEPBRDF_MUTATIONS")
         .ok()
         .and_then(|v| v.parse().ok())
