@@ -12,6 +12,7 @@ mod editing;
 mod fetch_merl;
 mod generalize;
 mod kill;
+mod mitsuba;
 mod model;
 mod recovery;
 mod reliability;

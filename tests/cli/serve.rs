@@ -244,7 +244,7 @@ fn serve_refuses_bad_input_with_4xx_and_keeps_running() {
         get(base, &format!("/api/download?format={format}&edit={}", encode(&edit.to_string())))
     };
     let (status, answer) = download("exe", &edit);
-    assert_eq!((status, text(&answer).contains("expected binary or latent")), (400, true));
+    assert_eq!((status, text(&answer).contains("expected binary, bsdf or latent")), (400, true));
     let (status, answer) =
         download("binary", &json!({"material": "merl/red-plastic", "roughness": -1}));
     assert_eq!(status, 400, "{}", text(&answer));
@@ -254,6 +254,11 @@ fn serve_refuses_bad_input_with_4xx_and_keeps_running() {
         .and_then(|f| f.to_table())
         .expect("the download is a MERL table");
     assert!(table.valid_cells() > 1_000_000);
+    let (status, bsdf) = download("bsdf", &edit);
+    assert_eq!(status, 200, "{}", text(&bsdf));
+    let brdf = deepbrdf_data::rgl::RglBrdf::parse(Path::new("download.bsdf"), &bsdf)
+        .expect("the .bsdf download is an RGL file the project's reader reads");
+    assert!(brdf.description().ends_with("(edited)"), "{}", brdf.description());
     let (status, latent) = download("latent", &edit);
     assert_eq!(status, 200);
     let latent: Value = serde_json::from_slice(&latent).unwrap();

@@ -1,5 +1,6 @@
-//! Mutation property test of the RGL reader and evaluator over the seven real bundled files:
-//! truncations, bit flips, header size fields set to extremes, NaN/inf/huge values in tables,
+//! Mutation property test of the RGL reader and evaluator over the seven real bundled files and
+//! two files the project's writer exported (`deepbrdf_data::rgl::export`, a Lambertian and a GGX
+//! table): truncations, bit flips, header size fields set to extremes, NaN/inf/huge values in tables,
 //! inserted and deleted bytes. Every mutated file must give either a valid evaluator (that then
 //! evaluates without panicking) or an error naming the file; never a panic or a huge
 //! allocation (every size is checked against the bytes present before allocating).
@@ -12,6 +13,7 @@ use deepbrdf_data::rgl::RglBrdf;
 use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
 use std::path::Path;
+use std::sync::OnceLock;
 
 const DEFAULT_CASES: usize = 2_000;
 
@@ -38,10 +40,36 @@ fn header_fields(b: &[u8]) -> Vec<(usize, usize)> {
     out
 }
 
+/// The seed files: the bundled measurements, then the writer's exports. Building them uses rayon:
+/// call it first on the test's own thread, never first from a rayon worker (whose pool the
+/// build would then wait for).
+fn corpus() -> &'static [(String, Vec<u8>)] {
+    static CORPUS: OnceLock<Vec<(String, Vec<u8>)>> = OnceLock::new();
+    CORPUS.get_or_init(|| {
+        use deepbrdf_data::testing::analytic::{ggx, lambertian_table, tabulate, Ggx};
+        let lobe = Ggx { alpha: 0.2, f0: [0.9, 0.5, 0.2], diffuse: [0.1; 3] };
+        let exports = [
+            ("exported lambertian", lambertian_table([0.5, 0.3, 0.1])),
+            ("exported ggx", tabulate(|wi, wo| ggx(&lobe, wi, wo))),
+        ];
+        let resolution = deepbrdf_data::rgl::ExportResolution::default();
+        let mut out: Vec<(String, Vec<u8>)> =
+            FILES.iter().map(|(n, b)| (n.to_string(), b.to_vec())).collect();
+        for (name, table) in exports {
+            let file = deepbrdf_data::rgl::export(&table, name, &resolution, "e.bsdf")
+                .expect("the writer exports the table");
+            out.push((name.to_string(), file.to_bytes()));
+        }
+        out
+    })
+}
+
 /// Mutation number `case` of one of the files.
 fn mutate(case: u64) -> (String, Vec<u8>) {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(case);
-    let (name, original) = FILES[rng.random_range(0..FILES.len())];
+    let corpus = corpus();
+    let (name, original) = &corpus[rng.random_range(0..corpus.len())];
+    let original = original.as_slice();
     let mut b = original.to_vec();
     let header_end = 420.min(b.len());
     let kind = rng.random_range(0..6);
@@ -133,7 +161,15 @@ fn run_case(case: u64) -> Result<bool, String> {
 }
 
 #[test]
+fn exported_files_parse_unmutated() {
+    for (name, bytes) in &corpus()[FILES.len()..] {
+        RglBrdf::parse(Path::new("e.bsdf"), bytes).unwrap_or_else(|e| panic!("{name}: {e}"));
+    }
+}
+
+#[test]
 fn mutated_real_files_never_panic() {
+    corpus();
     let cases: usize = std::env::var("DEEPBRDF_MUTATIONS")
         .ok()
         .and_then(|v| v.parse().ok())

@@ -55,6 +55,9 @@ pub enum Command {
     Sheet(commands::sheet::Args),
     /// Convert a real RGL measurement (.bsdf tensor file) to a MERL .binary file.
     Convert(commands::convert::Args),
+    /// Write a material as an RGL .bsdf file (isotropic RGB tensor file, Dupuy & Jakob 2018),
+    /// which Mitsuba 3 and pbrt-v4 render with their `measured` material.
+    ExportBsdf(commands::export_bsdf::Args),
     /// Evaluate the PCA and IPCA baselines (§4): summary table, CSV, plots.
     Baselines(commands::baselines::Args),
     /// Render the synthetic training set of single-image recovery (§5.2): one material per

@@ -70,6 +70,24 @@ impl Dtype {
         }
     }
 
+    /// The format's code of the type (the inverse of [`Dtype::from_code`]).
+    pub fn code(self) -> u8 {
+        use Dtype::*;
+        match self {
+            U8 => 1,
+            I8 => 2,
+            U16 => 3,
+            I16 => 4,
+            U32 => 5,
+            I32 => 6,
+            U64 => 7,
+            I64 => 8,
+            F16 => 9,
+            F32 => 10,
+            F64 => 11,
+        }
+    }
+
     /// Whether the type is a floating-point type.
     pub fn is_float(self) -> bool {
         matches!(self, Dtype::F16 | Dtype::F32 | Dtype::F64)
@@ -87,6 +105,16 @@ pub struct Field {
 }
 
 impl Field {
+    /// A field from its parts, which the caller has checked agree (`tensor_write`).
+    pub(super) fn new_unchecked(
+        name: String,
+        dtype: Dtype,
+        shape: Vec<usize>,
+        bytes: Vec<u8>,
+    ) -> Self {
+        Self { name, dtype, shape, bytes }
+    }
+
     /// The field's name.
     pub fn name(&self) -> &str {
         &self.name
@@ -165,6 +193,11 @@ pub struct TensorFile {
 }
 
 impl TensorFile {
+    /// A tensor file from fields the caller has checked (`tensor_write`).
+    pub(super) fn new_unchecked(path: PathBuf, fields: Vec<Field>) -> Self {
+        Self { path, fields }
+    }
+
     /// Reads and parses the tensor file at `path`.
     pub fn read(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
@@ -370,6 +403,7 @@ mod tests {
         let mut fields = Vec::new();
         for code in 1..=11u8 {
             let dtype = Dtype::from_code(code).expect("code");
+            assert_eq!(dtype.code(), code);
             let data: Vec<u8> = match dtype {
                 Dtype::U8 => vec![7, 250],
                 Dtype::I8 => vec![7, (-6i8) as u8],

@@ -12,12 +12,13 @@ use deepbrdf_render::brdf::MeasuredBrdf;
 use deepbrdf_render::{render, MerlBrdf};
 use std::path::PathBuf;
 
-/// The RGL evaluator of `spec`: a `.bsdf` file or `rgl-measured/NAME`.
-fn load_evaluator(spec: &str) -> anyhow::Result<RglBrdf> {
+/// The RGL evaluator of `spec` (material `which`, A or B, for `flag`): a `.bsdf` file or
+/// `rgl-measured/NAME`.
+fn load_evaluator(spec: &str, which: &str, flag: &str) -> anyhow::Result<RglBrdf> {
     match spec.strip_prefix("rgl-measured/") {
         Some(name) => Ok(bundled::load(name)?),
         None if spec.ends_with(".bsdf") => Ok(RglBrdf::read(spec)?),
-        None => bail!("--evaluator needs a .bsdf file or rgl-measured/NAME as B, not '{spec}'"),
+        None => bail!("{flag} needs a .bsdf file or rgl-measured/NAME as {which}, not '{spec}'"),
     }
 }
 
@@ -38,6 +39,11 @@ pub struct Args {
     /// measures what converting X to the MERL grid changes in the image.
     #[arg(long)]
     pub evaluator: bool,
+    /// Render A straight from the RGL evaluator instead of its MERL table (A must be a `.bsdf` file or an
+    /// `rgl-measured/NAME`), still sampled by A's MERL table: `compare rgl-measured/X OUT.bsdf
+    /// --evaluator-a --evaluator` measures an exported file against the original measurement.
+    #[arg(long)]
+    pub evaluator_a: bool,
     #[command(flatten)]
     pub scene: SceneArgs,
     #[command(flatten)]
@@ -54,9 +60,15 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     // Both rendered with A's sampling and the same seed: the same directions are drawn, so the
     // difference is the materials', not Monte Carlo noise.
     let brdf_a = MerlBrdf::new(&a);
-    let image_a = render(&setup.scene, &brdf_a, &setup.settings, progress)?;
+    let image_a = if args.evaluator_a {
+        let measured = load_evaluator(&args.a, "A", "--evaluator-a")?;
+        let brdf = MeasuredBrdf { brdf: &measured, sampling: &brdf_a };
+        render(&setup.scene, &brdf, &setup.settings, progress)?
+    } else {
+        render(&setup.scene, &brdf_a, &setup.settings, progress)?
+    };
     let image_b = if args.evaluator {
-        let measured = load_evaluator(&args.b)?;
+        let measured = load_evaluator(&args.b, "B", "--evaluator")?;
         let brdf = MeasuredBrdf { brdf: &measured, sampling: &brdf_a };
         render(&setup.scene, &brdf, &setup.settings, progress)?
     } else {
@@ -64,6 +76,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         render(&setup.scene, &brdf_b, &setup.settings, progress)?
     };
     let name_b = if args.evaluator { format!("{name_b} (evaluator)") } else { name_b };
+    let name_a = if args.evaluator_a { format!("{name_a} (evaluator)") } else { name_a };
     let c = compare_images(&image_b, &image_a, &setup.tonemap)?;
     difference_image(&image_b, &image_a, args.scale)?.write_png(&args.output)?;
     println!(

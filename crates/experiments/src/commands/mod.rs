@@ -13,6 +13,7 @@ pub mod devices;
 pub mod edit;
 pub mod edit_known;
 pub mod encode;
+pub mod export_bsdf;
 pub mod fetch_merl;
 pub mod figures_editing;
 pub mod figures_generalize;
@@ -53,6 +54,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Render(args) => render::run(args, &progress),
         Command::Compare(args) => compare::run(args, &progress),
         Command::Convert(args) => convert::run(args, &progress),
+        Command::ExportBsdf(args) => export_bsdf::run(args, &progress),
         Command::Sheet(args) => sheet::run(args, &progress),
         Command::Serve(args) => serve::run(args, &progress),
         Command::Baselines(args) => baselines::run(args, &progress),

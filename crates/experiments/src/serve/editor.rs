@@ -458,6 +458,15 @@ impl Editor {
                 file_name: format!("{stem}-edited.binary"),
                 bytes: merl_bytes(self.decoded(&z)?.as_ref()),
             },
+            Download::Bsdf => {
+                let file_name = format!("{stem}-edited.bsdf");
+                let name = format!("{} (edited)", material.name);
+                let resolution = deepbrdf_data::rgl::ExportResolution::default();
+                let table = self.decoded(&z)?;
+                let file = deepbrdf_data::rgl::export(&table, &name, &resolution, &file_name)
+                    .map_err(internal)?;
+                DownloadFile { file_name, bytes: file.to_bytes() }
+            }
             Download::Latent => DownloadFile {
                 file_name: format!("{stem}-edited.json"),
                 bytes: LatentFile::new(self.model.id(), &format!("{} (edited)", material.name), z)

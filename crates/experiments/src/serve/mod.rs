@@ -10,7 +10,7 @@
 //! | `POST /api/upload?name=FILE` (the file as the body) | reads a `.binary` / `.bsdf` upload |
 //! | `POST /api/original` `{"material": ID, "scene": ..}` | PNG of the original |
 //! | `POST /api/preview` `{"edit": .., "quality": "fast"/"refined"}` | the edited preview |
-//! | `GET /api/download?format=binary/latent&edit=JSON` | the edited `.binary` or latent file |
+//! | `GET /api/download?format=binary/bsdf/latent&edit=JSON` | the edited `.binary`, RGL `.bsdf` or latent file |
 //!
 //! Bad input is answered 4xx with a text message (400 bad values or files, 404 unknown
 //! materials, 409 a preview superseded by a newer one, 413 an oversized body); nothing a
@@ -218,11 +218,12 @@ async fn download(
     let Query(q) = query.map_err(|e| ApiError(StatusCode::BAD_REQUEST, e.body_text()))?;
     let what = match q.format.as_str() {
         "binary" => Download::Binary,
+        "bsdf" => Download::Bsdf,
         "latent" => Download::Latent,
         other => {
             return Err(ApiError(
                 StatusCode::BAD_REQUEST,
-                format!("format {other:?}: expected binary or latent"),
+                format!("format {other:?}: expected binary, bsdf or latent"),
             ))
         }
     };
@@ -230,7 +231,7 @@ async fn download(
         .map_err(|e| ApiError(StatusCode::BAD_REQUEST, format!("malformed edit: {e}")))?;
     let file = editor.download(edit.check(&editor.catalogue)?, what).await?;
     let kind = match what {
-        Download::Binary => "application/octet-stream",
+        Download::Binary | Download::Bsdf => "application/octet-stream",
         Download::Latent => "application/json",
     };
     // The file name is made of [A-Za-z0-9_-] by the editor.

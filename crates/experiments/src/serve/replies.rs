@@ -82,6 +82,9 @@ pub struct Seconds {
 pub enum Download {
     /// The edited MERL `.binary` table.
     Binary,
+    /// The edited table as an RGL `.bsdf` file (`deepbrdf_data::rgl::export`, default
+    /// resolutions), for Mitsuba 3 and pbrt-v4.
+    Bsdf,
     /// The edited latent as a latent file (JSON).
     Latent,
 }
