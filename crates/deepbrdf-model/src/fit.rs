@@ -11,6 +11,7 @@ use deepbrdf_data::{MerlTable, Progress};
 use crate::artifact::{ModelArtifact, MODEL_DIR};
 use crate::codec::DeepBrdf;
 use crate::error::Result;
+use crate::streamed::StreamedTables;
 use crate::train::{train_within, TrainConfig};
 use crate::training_set::TrainingSet;
 
@@ -21,12 +22,15 @@ use crate::training_set::TrainingSet;
 /// re-evaluated and re-saved); without it, an existing run there is an error. With a
 /// `time_limit`, training stops at the end of the first epoch past it and the model written
 /// has the epochs done so far (its provenance says how many); `resume` continues the run.
+/// `streamed` BRDFs (an analytic corpus) train beside the tables without being held whole
+/// (the `slice` network only); the reference is the tables' alone.
 #[allow(clippy::too_many_arguments)]
 pub fn fit(
     config: &TrainConfig,
     label: &str,
     names: &[String],
     tables: &[&MerlTable],
+    streamed: Option<StreamedTables>,
     out_dir: &Path,
     resume: bool,
     time_limit: Option<Duration>,
@@ -35,10 +39,14 @@ pub fn fit(
 ) -> Result<DeepBrdf> {
     config.validate()?;
     let reference = MedianReference::from_tables(tables)?;
-    let set = TrainingSet::from_tables(label, names, tables, &reference)?;
+    let mut set = TrainingSet::from_tables(label, names, tables, &reference)?;
+    if let Some(streamed) = streamed {
+        set = set.with_streamed(streamed)?;
+    }
+    let label = set.label().to_string();
     let trained = train_within(config, &set, out_dir, resume, time_limit, progress, device)?;
     drop(set);
-    let artifact = ModelArtifact::from_trained(trained, reference, label, names, device)?;
+    let artifact = ModelArtifact::from_trained(trained, reference, &label, names, device)?;
     artifact.save(&out_dir.join(MODEL_DIR))?;
     DeepBrdf::from_artifact(artifact, device)
 }

@@ -11,6 +11,7 @@ use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 
 use crate::error::{ModelError, Result};
+use crate::streamed::StreamedTables;
 
 /// Named BRDFs in the mapped §3.2 layout, ready to batch.
 ///
@@ -26,6 +27,9 @@ pub struct TrainingSet {
     /// The eq. (1) reference in layout order, for a set built from tables (augmentation maps
     /// through it, [`crate::autoencoder::slice::augmentation`]).
     reference: Option<Arc<Vec<f32>>>,
+    /// BRDFs streamed beside the held ones ([`StreamedTables`]; trained by the `slice`
+    /// network, which keeps their coefficients only).
+    streamed: Option<Arc<StreamedTables>>,
 }
 
 impl TrainingSet {
@@ -98,7 +102,7 @@ impl TrainingSet {
                 None => valid.push(mask.iter().map(|&m| f64::from(m)).sum()),
             }
         }
-        Ok(Self { label, names, inputs, masks, valid, reference })
+        Ok(Self { label, names, inputs, masks, valid, reference, streamed: None })
     }
 
     /// Maps `tables` with eq. (1) relative to `reference` and reorders them into the §3.2
@@ -162,6 +166,25 @@ impl TrainingSet {
         self.reference.as_deref().map(Vec::as_slice)
     }
 
+    /// The set with `streamed` BRDFs beside its own (they need the set's eq. (1) reference:
+    /// a set built from tables), its label extended with the stream's.
+    pub fn with_streamed(mut self, streamed: StreamedTables) -> Result<Self> {
+        if self.reference.is_none() {
+            return Err(ModelError::Invalid(format!(
+                "{}: streamed BRDFs need the eq. (1) reference of a set built from tables",
+                self.label
+            )));
+        }
+        self.label = format!("{}+{}", self.label, streamed.label());
+        self.streamed = Some(Arc::new(streamed));
+        Ok(self)
+    }
+
+    /// The BRDFs streamed beside the set's own, if any.
+    pub fn streamed(&self) -> Option<&StreamedTables> {
+        self.streamed.as_deref()
+    }
+
     /// The data source's label.
     pub fn label(&self) -> &str {
         &self.label
@@ -223,6 +246,9 @@ impl TrainingSet {
     pub fn fingerprint(&self) -> String {
         let mut hasher = Sha256::new();
         hasher.update(self.label.as_bytes());
+        if let Some(streamed) = &self.streamed {
+            hasher.update(streamed.identity().as_bytes());
+        }
         for (i, name) in self.names.iter().enumerate() {
             hasher.update((name.len() as u64).to_le_bytes());
             hasher.update(name.as_bytes());

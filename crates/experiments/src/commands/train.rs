@@ -156,12 +156,13 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         data.names.extend(more.names);
         data.tables.extend(more.tables);
     }
-    args.corpus.add_to(&mut data, progress)?;
+    let streamed = args.corpus.streamed()?;
     eprintln!(
-        "training DeepBRDF k = {} on {} ({} BRDFs), {} epochs of batches of {}, on {kind}",
+        "training DeepBRDF k = {} on {}{} ({} BRDFs), {} epochs of batches of {}, on {kind}",
         config.model.latent,
         data.label,
-        data.len(),
+        streamed.as_ref().map_or_else(String::new, |s| format!("+{}", s.label())),
+        data.len() + streamed.as_ref().map_or(0, |s| s.len()),
         config.epochs,
         config.batch_size
     );
@@ -171,6 +172,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         &data.label,
         &data.names,
         &tables,
+        streamed,
         &out,
         resume,
         args.time_limit,

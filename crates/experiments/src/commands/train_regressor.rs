@@ -9,7 +9,7 @@ use crate::data_args::DataArgs;
 use crate::editing::{self, ipca_owner_id};
 use crate::model_arg::ModelArg;
 use anyhow::{bail, Context};
-use deepbrdf_data::Progress;
+use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::attributes::FitConfig;
 use deepbrdf_eval::baseline::{BaselineBasis, MappingKind};
 use deepbrdf_model::burn::tensor::Device;
@@ -108,41 +108,67 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     }
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     let device = crate::device_arg::device()?;
+    let set = args.data.load(progress)?;
+    let streamed = args.corpus.streamed()?;
     let model = DeepBrdf::load(&model_dir, &device)
         .with_context(|| format!("loading the model {}", model_dir.display()))?;
-    let mut set = args.data.load(progress)?;
-    args.corpus.add_to(&mut set, progress)?;
+    let k = model.k();
+    // IPCA's basis is fitted to the held tables (a streamed corpus is not held); every
+    // material, streamed ones included, gets its coefficients in it as a regression target.
+    let ipca = match args.ipca {
+        true => {
+            let refs: Vec<_> = set.tables.iter().collect();
+            let basis = BaselineBasis::fit("IPCA", MappingKind::LogRelative, &refs, k, progress)?;
+            basis.save(&out.join(IPCA_BASIS_FILE))?;
+            Some(basis)
+        }
+        false => None,
+    };
     let fit = FitConfig::default();
-    progress.start(set.len() as u64, "attributes and latents");
-    let mut attributes = Vec::with_capacity(set.len());
-    let mut latents = Vec::with_capacity(set.len());
-    for (name, table) in set.names.iter().zip(&set.tables) {
+    let total = set.len() + streamed.as_ref().map_or(0, |s| s.len());
+    let mut names = Vec::with_capacity(total);
+    let mut attributes = Vec::with_capacity(total);
+    let mut latents = Vec::with_capacity(total);
+    let mut coefficients = Vec::with_capacity(if ipca.is_some() { total } else { 0 });
+    let mut add = |name: &str, table: &MerlTable| -> anyhow::Result<()> {
         attributes.push(editing::attributes_of(table, name, &fit)?.to_array());
         latents.push(model.encode(table).with_context(|| format!("encoding {name}"))?);
+        if let Some(basis) = &ipca {
+            coefficients.push(basis.encode(table, k)?);
+        }
+        names.push(name.to_string());
+        Ok(())
+    };
+    progress.start(set.len() as u64, "attributes and latents");
+    for (name, table) in set.names.iter().zip(&set.tables) {
+        add(name, table)?;
         progress.advance(1);
     }
     progress.finish();
+    let mut label = set.label.clone();
+    if let Some(streamed) = &streamed {
+        progress.start(streamed.len() as u64, "attributes and latents of the streamed corpus");
+        let mut failed = None;
+        let streamed_result = streamed.for_each(progress, |_, name, table| {
+            add(name, &table).map_err(|e| {
+                failed = Some(e);
+                deepbrdf_model::ModelError::Invalid("stopped".into())
+            })
+        });
+        if let Some(e) = failed {
+            return Err(e);
+        }
+        streamed_result?;
+        progress.finish();
+        label = format!("{label}+{}", streamed.label());
+    }
+    drop(add);
     let config = config(args.epochs, args.seed);
-    let data = RegressorData {
-        label: set.label.clone(),
-        names: set.names.clone(),
-        attributes: attributes.clone(),
-        targets: latents,
-    };
-    let target =
-        Target { kind: TargetKind::DeepBrdf, owner_id: model.id().to_string(), k: model.k() };
+    let data = RegressorData { label, names, attributes, targets: latents };
+    let target = Target { kind: TargetKind::DeepBrdf, owner_id: model.id().to_string(), k };
     train_into(&out, &data, &config, target, progress, &device)?;
-    if args.ipca {
-        let k = model.k();
+    if let Some(basis) = ipca {
         drop(model);
-        let refs: Vec<_> = set.tables.iter().collect();
-        let basis = BaselineBasis::fit("IPCA", MappingKind::LogRelative, &refs, k, progress)?;
-        basis.save(&out.join(IPCA_BASIS_FILE))?;
-        let coefficients = set
-            .tables
-            .iter()
-            .map(|t| basis.encode(t, k))
-            .collect::<deepbrdf_eval::Result<Vec<_>>>()?;
         let data = RegressorData { targets: coefficients, ..data };
         let target = Target { kind: TargetKind::Ipca, owner_id: ipca_owner_id(&basis, k), k };
         train_into(&out, &data, &config, target, progress, &device)?;

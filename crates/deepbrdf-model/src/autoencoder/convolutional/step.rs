@@ -26,6 +26,13 @@ impl<'a> ConvolutionalStep<'a> {
         config: &'a TrainConfig,
         data: &'a TrainingSet,
     ) -> crate::error::Result<Self> {
+        if let Some(streamed) = data.streamed() {
+            return Err(crate::error::ModelError::Invalid(format!(
+                "{}: streamed BRDFs train the slice network only (the convolutional network \
+                 reads whole layouts every epoch)",
+                streamed.label()
+            )));
+        }
         Ok(Self { config, data, dropout: config.dropout()?, offset: None })
     }
 }

@@ -22,6 +22,7 @@ use super::config::SliceConfig;
 use crate::autoencoder::Autoencoder;
 use crate::error::ModelError;
 use crate::loss::colour_weights;
+use crate::streamed::mapped_layout;
 use crate::train::autoencoder::batch::{centre, filled_input, SliceDropout};
 use crate::train::autoencoder::config::TrainConfig;
 use crate::train::run::{on_device, TrainStep};
@@ -50,9 +51,10 @@ impl<'a> SliceStep<'a> {
         Ok(Self { config, layers, data, dropout: config.dropout()?, fit: None })
     }
 
-    /// The number of training samples: the BRDFs and their augmentations.
+    /// The number of training samples: the BRDFs, their augmentations and the streamed BRDFs.
     pub(crate) fn samples(&self) -> usize {
         self.layers.augmentation.samples(self.data.len())
+            + self.data.streamed().map_or(0, |s| s.len())
     }
 }
 
@@ -181,6 +183,39 @@ fn prepare(
         progress.advance(group.len() as u64);
     }
     progress.finish();
+    if let Some(streamed) = data.streamed() {
+        let reference = data.reference_layout().ok_or_else(|| {
+            ModelError::Invalid(format!(
+                "{}: streamed BRDFs need the set's reference",
+                data.label()
+            ))
+        })?;
+        let power = (power > 0.0).then_some(power);
+        progress.start(streamed.len() as u64, "tabulating and projecting the streamed BRDFs");
+        let mut group: Vec<(Vec<f32>, f64)> = Vec::with_capacity(PROJECTED_AT_ONCE);
+        let mut flush = |group: &mut Vec<(Vec<f32>, f64)>| -> crate::error::Result<()> {
+            let layouts: Vec<&[f32]> = group.iter().map(|(l, _)| l.as_slice()).collect();
+            if let Some(p) = power {
+                weights.extend(layouts.iter().map(|l| colour_weights(l, reference, p)));
+            }
+            for ((a, r), (_, count)) in project(&layouts, &bt)?.into_iter().zip(group.iter()) {
+                targets.push(a);
+                residuals.push(r);
+                valid.push(*count);
+            }
+            group.clear();
+            Ok(())
+        };
+        streamed.for_each(progress, |_, _, table| {
+            group.push(mapped_layout(&table, reference)?);
+            if group.len() == PROJECTED_AT_ONCE {
+                flush(&mut group)?;
+            }
+            Ok(())
+        })?;
+        flush(&mut group)?;
+        progress.finish();
+    }
     let weights = reference.map(|_| normalised(weights));
     if let Some(weights) = &weights {
         let mut all: Vec<f32> = weights.iter().flatten().copied().collect();
