@@ -36,6 +36,9 @@ pub enum Command {
     Corpus(commands::corpus::Args),
     /// Pack folders of JSON NBRDF networks into the bundled .nbrdf files.
     PackNbrdf(commands::pack_nbrdf::Args),
+    /// Rewrite models, recovery networks and .svg charts (or folders of them) in place in their
+    /// compact, lossless forms (maintainers: the repository's size).
+    Compact(commands::compact::Args),
     /// Train DeepBRDF (§3.2) on a dataset; resumable.
     Train(commands::train::Args),
     /// Print the k latent values of a BRDF under a trained model (eq. 2).

@@ -5,6 +5,7 @@ use crate::progress::Bars;
 pub mod attributes;
 pub mod baselines;
 pub mod bench;
+pub mod compact;
 pub mod compare;
 pub mod convert;
 pub mod corpus;
@@ -45,6 +46,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Folds(args) => folds::run(args, &progress),
         Command::Tabulate(args) => tabulate::run(args, &progress),
         Command::PackNbrdf(args) => pack_nbrdf::run(args, &progress),
+        Command::Compact(args) => compact::run(args, &progress),
         Command::Corpus(args) => corpus::run(args, &progress),
         Command::Train(args) => train::run(args, &progress),
         Command::Encode(args) => encode::run(args, &progress),
