@@ -61,6 +61,9 @@ pub enum Command {
     /// Write a material as an RGL .bsdf file (isotropic RGB tensor file, Dupuy & Jakob 2018),
     /// which Mitsuba 3 and pbrt-v4 render with their `measured` material.
     ExportBsdf(commands::export_bsdf::Args),
+    /// Round trip of real RGL measurements (measurement -> MERL -> .bsdf): image RelAE of the
+    /// exports against the measurement, beside the MERL table's own.
+    RoundTrip(commands::round_trip::Args),
     /// Evaluate the PCA and IPCA baselines (§4): summary table, CSV, plots.
     Baselines(commands::baselines::Args),
     /// Render the synthetic training set of single-image recovery (§5.2): one material per

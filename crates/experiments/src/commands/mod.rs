@@ -27,6 +27,7 @@ pub mod reconstruct;
 pub mod recover;
 pub mod render;
 pub mod render_set;
+pub mod round_trip;
 pub mod serve;
 pub mod sheet;
 pub mod sweep_k;
@@ -57,6 +58,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Compare(args) => compare::run(args, &progress),
         Command::Convert(args) => convert::run(args, &progress),
         Command::ExportBsdf(args) => export_bsdf::run(args, &progress),
+        Command::RoundTrip(args) => round_trip::run(args, &progress),
         Command::Sheet(args) => sheet::run(args, &progress),
         Command::Serve(args) => serve::run(args, &progress),
         Command::Baselines(args) => baselines::run(args, &progress),
