@@ -5,25 +5,26 @@
 use crate::util;
 use deepbrdf_data::MerlTable;
 
-const PAPER: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../deepbrdf-data/assets/rgl-measured/paper_white_rgb.bsdf"
-);
-
 #[test]
 fn convert_writes_a_merl_file_and_bsdf_paths_are_materials() {
     let dir = tempfile::tempdir().expect("tempdir");
+    // The bundled measurement as the RGL database's file (the crate holds it compressed).
+    let paper = dir.path().join("paper_white_rgb.bsdf");
+    let bytes = deepbrdf_data::rgl::bundled::bytes("paper_white_rgb").expect("bundled");
+    std::fs::write(&paper, &bytes).expect("write");
+    let paper = paper.to_string_lossy().into_owned();
+    let paper = paper.as_str();
     let cache = dir.path().join("cache").to_string_lossy().into_owned();
     let out = dir.path().join("paper.binary");
     let out_s = out.to_string_lossy().into_owned();
-    let o = util::run(&["convert", PAPER, "-o", &out_s]);
+    let o = util::run(&["convert", paper, "-o", &out_s]);
     assert!(o.status.success(), "{}", util::stderr(&o));
     let text = util::stdout(&o);
     assert!(text.contains("1096216 valid cells") && text.contains("White A4 paper"), "{text}");
     let table = MerlTable::read(&out).expect("a MERL file");
     assert_eq!(table.valid_cells(), 1_096_216);
     // The same material through its .bsdf path (converted and cached) and its bundled name.
-    for spec in [PAPER, "rgl-measured/paper_white_rgb"] {
+    for spec in [paper, "rgl-measured/paper_white_rgb"] {
         let o = util::run(&["info", spec, "--cache", &cache]);
         assert!(o.status.success(), "{}", util::stderr(&o));
         let info = util::stdout(&o);
@@ -33,11 +34,10 @@ fn convert_writes_a_merl_file_and_bsdf_paths_are_materials() {
     let tables = std::fs::read_dir(dir.path().join("cache").join("tables")).expect("cache").count();
     assert_eq!(tables, 1);
     // The output exists now: not overwritten without --force.
-    let again = util::run(&["convert", PAPER, "-o", &out_s]);
+    let again = util::run(&["convert", paper, "-o", &out_s]);
     util::assert_clean_failure(&again, "not overwriting");
     // A truncated input: an error naming it.
     let bad = dir.path().join("cut.bsdf");
-    let bytes = std::fs::read(PAPER).expect("read");
     std::fs::write(&bad, &bytes[..bytes.len() / 2]).expect("write");
     let bad_s = bad.to_string_lossy().into_owned();
     let o = util::run(&["convert", &bad_s, "-o", &dir.path().join("x.binary").to_string_lossy()]);

@@ -98,30 +98,24 @@ fn load_bundled(
 
 /// The bundled RGL measurements, converted to the MERL grid (cached).
 fn load_measured(cache: &Cache, progress: &dyn Progress) -> Result<(Vec<String>, Vec<MerlTable>)> {
-    let files = &crate::rgl::bundled::FILES;
-    progress.start(files.len() as u64, "converting rgl-measured");
-    let tables = files
+    let names = crate::rgl::bundled::names();
+    progress.start(names.len() as u64, "converting rgl-measured");
+    let tables = names
         .iter()
-        .map(|(name, _)| {
+        .map(|name| {
             let table = load_measured_material(name, cache);
             progress.advance(1);
             table
         })
         .collect::<Result<Vec<_>>>();
     progress.finish();
-    Ok((files.iter().map(|(n, _)| n.to_string()).collect(), tables?))
+    Ok((names.iter().map(|n| n.to_string()).collect(), tables?))
 }
 
 /// The bundled measurement `name`, converted to the MERL grid (cached).
 fn load_measured_material(name: &str, cache: &Cache) -> Result<MerlTable> {
-    let bytes = crate::rgl::bundled::bytes(name).ok_or_else(|| {
-        DataError::Invalid(format!(
-            "no measurement named {name:?} in rgl-measured: expected one of {}",
-            crate::rgl::bundled::names().join(", ")
-        ))
-    })?;
-    let origin = format!("<bundled rgl-measured/{name}.bsdf>");
-    Ok(cache.converted(name, Path::new(&origin), bytes)?.0)
+    let bytes = crate::rgl::bundled::bytes(name)?;
+    Ok(cache.converted(name, &crate::rgl::bundled::origin(name), &bytes)?.0)
 }
 
 /// An RGL `.bsdf` file converted to the MERL grid (cached under the file's stem).

@@ -16,6 +16,7 @@ pub mod merl;
 pub mod named;
 pub mod nbrdf;
 pub mod network_input;
+pub mod packed;
 pub mod progress;
 pub mod rgl;
 pub mod summary;

@@ -8,7 +8,7 @@
 //! The normal suite runs `DEFAULT_CASES` mutations (a few seconds); set
 //! `DEEPBRDF_MUTATIONS=1000000` for a long run (the count and findings are printed).
 
-use deepbrdf_data::rgl::bundled::FILES;
+use deepbrdf_data::rgl::bundled;
 use deepbrdf_data::rgl::RglBrdf;
 use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
@@ -53,8 +53,11 @@ fn corpus() -> &'static [(String, Vec<u8>)] {
             ("exported ggx", tabulate(|wi, wo| ggx(&lobe, wi, wo))),
         ];
         let resolution = deepbrdf_data::rgl::ExportResolution::default();
-        let mut out: Vec<(String, Vec<u8>)> =
-            FILES.iter().map(|(n, b)| (n.to_string(), b.to_vec())).collect();
+        let mut out: Vec<(String, Vec<u8>)> = bundled::files()
+            .expect("the bundled files")
+            .into_iter()
+            .map(|(n, b)| (n.to_string(), b))
+            .collect();
         for (name, table) in exports {
             let file = deepbrdf_data::rgl::export(&table, name, &resolution, "e.bsdf")
                 .expect("the writer exports the table");
@@ -162,7 +165,7 @@ fn run_case(case: u64) -> Result<bool, String> {
 
 #[test]
 fn exported_files_parse_unmutated() {
-    for (name, bytes) in &corpus()[FILES.len()..] {
+    for (name, bytes) in &corpus()[bundled::names().len()..] {
         RglBrdf::parse(Path::new("e.bsdf"), bytes).unwrap_or_else(|e| panic!("{name}: {e}"));
     }
 }

@@ -14,6 +14,8 @@ pub mod metrics;
 pub mod pca;
 pub mod recovery;
 pub mod robustness;
+pub mod round_trip;
+pub mod saved_sweep;
 pub mod stats;
 pub mod sweep_report;
 

@@ -11,7 +11,7 @@
 use crate::deep::{DeepMethod, MappedInput, NAME};
 use crate::error::{EvalError, Result};
 use crate::figures::{write_chart, LineChart, Series};
-use crate::harness::{csv_field, Fold, Measure, Results, Yardstick};
+use crate::harness::{csv_field, csv_rows, parsed, Fold, Measure, Results, Yardstick};
 use crate::stats::mean;
 use deepbrdf_data::augment::{kept_slices, SliceSelection};
 use deepbrdf_data::files::write_atomic;
@@ -221,6 +221,31 @@ impl Robustness {
         }
         let _ = writeln!(s, "Robustness evaluation: {:.1} s.\n", self.seconds);
         s
+    }
+
+    /// The records written into `dir` by [`Self::write`] (`robustness.csv`); the k are
+    /// DeepBRDF's there, the time 0.
+    pub fn read(dir: &Path) -> Result<Self> {
+        let path = dir.join("robustness.csv");
+        let mut records = Vec::new();
+        for row in csv_rows(&path, "input,method,k,fold,material,mapped_mse")? {
+            let every = row[0].strip_prefix("1/").unwrap_or(&row[0]);
+            records.push(RobustnessRecord {
+                every: parsed(&path, "input", every)?,
+                method: row[1].clone(),
+                k: match row[2].is_empty() {
+                    true => None,
+                    false => Some(parsed(&path, "k", &row[2])?),
+                },
+                fold: parsed(&path, "fold", &row[3])?,
+                material: row[4].clone(),
+                mapped_mse: parsed(&path, "mapped_mse", &row[5])?,
+            });
+        }
+        let mut ks: Vec<usize> = records.iter().filter_map(|r| r.k).collect();
+        ks.sort_unstable();
+        ks.dedup();
+        Ok(Self { ks, records, seconds: 0.0 })
     }
 
     /// Writes `robustness.csv` (every record) and `robustness.svg` into `dir`.

@@ -4,7 +4,8 @@
 //! ```text
 //! model/
 //!   model.json             id, network configuration, training provenance, part checksums
-//!   weights.bpk            the network's parameters (burnpack, Burn's record format)
+//!   weights.bpk            the network's parameters (burnpack, Burn's record format), written
+//!                          packed (`deepbrdf_data::packed`, lossless); a plain record is read too
 //!   median_reference.bin   the eq. (1) reference of the training data (deepbrdf-data format,
 //!                          written zstd-compressed)
 //! ```
@@ -23,7 +24,7 @@ use deepbrdf_data::mapping::MedianReference;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
-use crate::atomic::{check_format, read_limited, write_atomic, write_manifest};
+use crate::atomic::{check_format, read_limited, read_weights, write_manifest, write_weights};
 use crate::autoencoder::{retired_network, Autoencoder, AutoencoderConfig};
 use crate::error::{ModelError, Result};
 use crate::train::Trained;
@@ -237,7 +238,7 @@ impl ModelArtifact {
     }
 
     fn write_parts(&self, dir: &Path) -> Result<()> {
-        write_atomic(&dir.join(WEIGHTS_FILE), &[&self.weights])?;
+        write_weights(&dir.join(WEIGHTS_FILE), &self.weights)?;
         self.reference.save_compressed(dir.join(REFERENCE_FILE))?;
         let manifest = Manifest {
             format: FORMAT.into(),
@@ -260,7 +261,7 @@ impl ModelArtifact {
         let text = read_limited(&manifest_path, 64 << 20)?;
         let (manifest, config) = parse_manifest(&manifest_path, &text)?;
         let weights_path = dir.join(WEIGHTS_FILE);
-        let weights = read_limited(&weights_path, 4 << 30)?;
+        let weights = read_weights(&weights_path, 4 << 30)?;
         if part_of(&weights, WEIGHTS_FILE) != manifest.weights {
             return Err(ModelError::mismatch(
                 &weights_path,

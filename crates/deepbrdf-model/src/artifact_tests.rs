@@ -97,6 +97,44 @@ fn saved_artifacts_load_and_mismatched_parts_are_detected() {
 }
 
 #[test]
+fn a_model_saved_in_the_earlier_form_loads_with_the_same_id_and_weights() {
+    // Earlier versions wrote weights.bpk as a plain burnpack record and the median reference
+    // as one zstd frame (or plain); this version writes both packed. Every form loads to the
+    // same id, reference and network.
+    let device = DeviceKind::default_kind().unwrap().device().unwrap();
+    let model = tiny().init_seeded(4, &device).unwrap();
+    let values = (0..VALUES).map(|i| 0.01 + (i % 313) as f32 * 0.003).collect();
+    let reference = MedianReference::from_values(values).unwrap();
+    let artifact = ModelArtifact::new(tiny(), provenance(), &model, reference.clone()).unwrap();
+    let root = tempfile::tempdir().unwrap();
+    let packed = root.path().join("packed");
+    artifact.save(&packed).unwrap();
+    for file in [WEIGHTS_FILE, REFERENCE_FILE] {
+        let stored = fs::read(packed.join(file)).unwrap();
+        assert!(deepbrdf_data::packed::is_packed(&stored), "{file}");
+    }
+    let plain_reference = root.path().join("plain.bin");
+    reference.save(&plain_reference).unwrap();
+    let plain_reference = fs::read(&plain_reference).unwrap();
+    let zstd_reference = zstd::bulk::compress(&plain_reference, 3).unwrap();
+    let record = crate::atomic::read_weights(&packed.join(WEIGHTS_FILE), 1 << 30).unwrap();
+    let z = Tensor::<2>::from_floats([[0.4, -0.2]], &device);
+    let expected: Vec<f32> = model.decode(z.clone()).into_data().try_into_vec().unwrap();
+    for (name, reference_bytes) in [("zstd", &zstd_reference), ("plain", &plain_reference)] {
+        let old = root.path().join(name);
+        copy_dir(&packed, &old);
+        fs::write(old.join(WEIGHTS_FILE), &record).unwrap();
+        fs::write(old.join(REFERENCE_FILE), reference_bytes).unwrap();
+        let back = ModelArtifact::load(&old).unwrap();
+        assert_eq!(back.id(), artifact.id(), "{name}");
+        assert_eq!(back.reference(), &reference, "{name}");
+        let got: Vec<f32> =
+            back.model(&device).unwrap().decode(z.clone()).into_data().try_into_vec().unwrap();
+        assert_eq!(got, expected, "{name}");
+    }
+}
+
+#[test]
 fn a_model_of_a_retired_format_is_refused_with_what_to_do() {
     // Minimal manifests of the kinds earlier versions wrote: the `cpu` preset's spectral
     // network with its compact basis, and the flat configuration format.

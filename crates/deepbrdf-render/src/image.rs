@@ -292,14 +292,34 @@ impl Srgb8Image {
         Ok(deepbrdf_data::files::write_atomic(path, &png)?)
     }
 
-    /// The PNG encoding of the image.
+    /// The PNG encoding of the image, at the encoder's best compression with adaptive filters
+    /// (lossless either way; figures are committed, and the smaller file is worth the time).
     pub fn png_bytes(&self) -> Result<Vec<u8>> {
-        let img = image::RgbImage::from_raw(self.width, self.height, self.data.clone())
-            .ok_or_else(|| RenderError::Invalid("image buffer has the wrong size".into()))?;
+        use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+        use image::ImageEncoder;
+        if self.data.len() != 3 * self.width as usize * self.height as usize {
+            return Err(RenderError::Invalid("image buffer has the wrong size".into()));
+        }
         let mut png = Vec::new();
-        img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        PngEncoder::new_with_quality(&mut png, CompressionType::Best, FilterType::Adaptive)
+            .write_image(&self.data, self.width, self.height, image::ExtendedColorType::Rgb8)
             .map_err(|e| RenderError::Invalid(format!("cannot encode PNG: {e}")))?;
         Ok(png)
+    }
+
+    /// The RGB image of a PNG file's bytes `png` (read from `path`, which errors name); `None`
+    /// for a PNG of another colour type (grey, alpha, 16 bits), which this type cannot hold.
+    pub fn from_png(path: &Path, png: &[u8]) -> Result<Option<Srgb8Image>> {
+        let bad = |e: image::ImageError| RenderError::format(path, format!("not a PNG image: {e}"));
+        let decoded =
+            image::load_from_memory_with_format(png, image::ImageFormat::Png).map_err(bad)?;
+        Ok(match decoded {
+            image::DynamicImage::ImageRgb8(rgb) => {
+                let (width, height) = rgb.dimensions();
+                Some(Srgb8Image { width, height, data: rgb.into_raw() })
+            }
+            _ => None,
+        })
     }
 }
 

@@ -36,6 +36,9 @@ pub enum Command {
     Corpus(commands::corpus::Args),
     /// Pack folders of JSON NBRDF networks into the bundled .nbrdf files.
     PackNbrdf(commands::pack_nbrdf::Args),
+    /// Rewrite models, recovery networks and .svg charts (or folders of them) in place in their
+    /// compact, lossless forms (maintainers: the repository's size).
+    Compact(commands::compact::Args),
     /// Train DeepBRDF (§3.2) on a dataset; resumable.
     Train(commands::train::Args),
     /// Print the k latent values of a BRDF under a trained model (eq. 2).
@@ -58,6 +61,9 @@ pub enum Command {
     /// Write a material as an RGL .bsdf file (isotropic RGB tensor file, Dupuy & Jakob 2018),
     /// which Mitsuba 3 and pbrt-v4 render with their `measured` material.
     ExportBsdf(commands::export_bsdf::Args),
+    /// Round trip of real RGL measurements (measurement -> MERL -> .bsdf): image RelAE of the
+    /// exports against the measurement, beside the MERL table's own.
+    RoundTrip(commands::round_trip::Args),
     /// Evaluate the PCA and IPCA baselines (§4): summary table, CSV, plots.
     Baselines(commands::baselines::Args),
     /// Render the synthetic training set of single-image recovery (§5.2): one material per

@@ -9,14 +9,16 @@
 //! | 4 x values       | the values, f32 little-endian, channel-major MERL order |
 //! | 32               | SHA-256 of all preceding bytes                        |
 //!
-//! [`MedianReference::save_compressed`] writes the same bytes as one zstd frame (lossless: the
-//! values and their checksum are unchanged); [`MedianReference::load`] reads either form,
-//! telling them apart by their first bytes.
+//! [`MedianReference::save_compressed`] writes the same bytes packed ([`crate::packed`], word
+//! differences then byte planes then zstd: lossless, the values and their checksum are
+//! unchanged); [`MedianReference::load`] reads that form, the plain one, and the single zstd
+//! frame of the same bytes that earlier versions wrote, telling them apart by their first bytes.
 
 use super::MedianReference;
 use crate::error::{DataError, Result};
 use crate::files::{open_regular, read_exactly, write_atomic};
 use crate::merl::VALUES;
+use crate::packed::{self, Arrangement};
 use sha2::{Digest, Sha256};
 use std::io::Read;
 use std::path::Path;
@@ -33,9 +35,6 @@ const CHECKSUM_BYTES: usize = 32;
 const FILE_BYTES: usize = HEADER_BYTES + 4 * VALUES + CHECKSUM_BYTES;
 /// The first bytes of a zstd frame.
 const ZSTD_MAGIC: [u8; 4] = [0x28, 0xB5, 0x2F, 0xFD];
-/// zstd's level for [`MedianReference::save_compressed`]: higher levels shrink the file by a few
-/// percent more and take seconds instead of a fraction of one.
-const ZSTD_LEVEL: i32 = 3;
 /// The largest compressed file read: zstd adds a little to incompressible data, never this much.
 const MAX_COMPRESSED_BYTES: u64 = FILE_BYTES as u64 + (1 << 20);
 
@@ -45,13 +44,12 @@ impl MedianReference {
         write_atomic(path.as_ref(), &self.to_bytes())
     }
 
-    /// Saves the reference to `path` as one zstd frame of the bytes [`Self::save`] writes,
-    /// atomically; [`Self::load`] reads it back to the same values.
+    /// Saves the reference to `path` packed ([`crate::packed`]: the bytes [`Self::save`]
+    /// writes, compressed losslessly), atomically; [`Self::load`] reads it back to the same
+    /// values.
     pub fn save_compressed(&self, path: impl AsRef<Path>) -> Result<()> {
-        let path = path.as_ref();
-        let packed = zstd::bulk::compress(&self.to_bytes(), ZSTD_LEVEL)
-            .map_err(|e| DataError::io(path, e))?;
-        write_atomic(path, &packed)
+        let packed = packed::pack(&self.to_bytes(), Arrangement::DifferencePlanes)?;
+        write_atomic(path.as_ref(), &packed)
     }
 
     /// The file format's bytes (module documentation).
@@ -68,9 +66,10 @@ impl MedianReference {
         bytes
     }
 
-    /// Loads a reference saved by [`Self::save`] or [`Self::save_compressed`]. Every malformed
+    /// Loads a reference saved by [`Self::save`] or [`Self::save_compressed`] (or as one zstd
+    /// frame, as earlier versions saved it). Every malformed
     /// file (empty, truncated, other magic, version or length, trailing bytes, checksum
-    /// mismatch, invalid values, a damaged or oversized zstd frame) is an error naming the
+    /// mismatch, invalid values, a damaged or oversized compressed form) is an error naming the
     /// file; nothing is allocated before the file's size has been checked, and a compressed
     /// file is never inflated past the size of the format.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
@@ -81,16 +80,17 @@ impl MedianReference {
         }
         let mut header = [0u8; HEADER_BYTES];
         let got = read_prefix(&mut file, path, &mut header)?;
-        if got >= ZSTD_MAGIC.len() && header[..4] == ZSTD_MAGIC {
+        let packed = packed::is_packed(&header[..got]);
+        if packed || (got >= ZSTD_MAGIC.len() && header[..4] == ZSTD_MAGIC) {
             if len > MAX_COMPRESSED_BYTES {
                 return Err(DataError::format(
                     path,
                     format!("{len} bytes: too large for a compressed median reference"),
                 ));
             }
-            let mut packed = header[..got].to_vec();
-            file.read_to_end(&mut packed).map_err(|e| DataError::io(path, e))?;
-            return Self::from_compressed(path, &packed);
+            let mut bytes = header[..got].to_vec();
+            file.read_to_end(&mut bytes).map_err(|e| DataError::io(path, e))?;
+            return Self::from_compressed(path, &bytes);
         }
         check_header(path, &header[..got], len as usize)?;
         if len > FILE_BYTES as u64 {
@@ -107,10 +107,13 @@ impl MedianReference {
         Self::from_file_bytes(path, &bytes)
     }
 
-    /// The reference in `packed`, a file written by [`Self::save_compressed`] (read from
-    /// `path`, which errors name). Inflating stops with an error past the format's size, so no
-    /// frame is expanded beyond it.
+    /// The reference in `packed`, the plain form packed ([`Self::save_compressed`]) or as one
+    /// zstd frame (read from `path`, which errors name). Inflating stops with an error past the
+    /// format's size, so no frame is expanded beyond it.
     fn from_compressed(path: &Path, packed: &[u8]) -> Result<Self> {
+        if packed::is_packed(packed) {
+            return Self::from_file_bytes(path, &packed::unpack(path, packed, FILE_BYTES as u64)?);
+        }
         let raw = zstd::bulk::decompress(packed, FILE_BYTES).map_err(|e| {
             DataError::format(path, format!("a damaged compressed median reference: {e}"))
         })?;
@@ -237,13 +240,19 @@ mod tests {
         let digest = Sha256::digest(&nan);
         nan.extend_from_slice(&digest);
         check(&nan, "value 0")?;
-        // The compressed form: the same values back; damaged, oversized or foreign frames are
-        // errors naming the file.
-        let packed = dir.path().join("median.bin.zst");
+        // The packed form: the same values back; damaged packed files are errors naming the file.
+        let packed = dir.path().join("median.bin.packed");
         reference.save_compressed(&packed)?;
         assert!(std::fs::metadata(&packed)?.len() < FILE_BYTES as u64 / 2);
         assert_eq!(MedianReference::load(&packed)?, reference);
-        let frame = std::fs::read(&packed)?;
+        let stored = std::fs::read(&packed)?;
+        check(&stored[..stored.len() / 2], "damaged packed")?;
+        // The single zstd frame that earlier versions saved still loads to the same values;
+        // damaged, oversized or foreign frames are errors naming the file.
+        let frame = zstd::bulk::compress(&good, 3)?;
+        let old = dir.path().join("median.bin.zst");
+        std::fs::write(&old, &frame)?;
+        assert_eq!(MedianReference::load(&old)?, reference);
         check(&frame[..frame.len() / 2], "damaged compressed")?;
         let bomb = zstd::bulk::compress(&vec![0u8; 4 * FILE_BYTES], 3)?;
         check(&bomb, "damaged compressed")?;
@@ -264,7 +273,8 @@ mod tests {
         let dir = tempfile::tempdir()?;
         let path = dir.path().join("median.bin");
         reference.save_compressed(&path)?;
-        let corpus = vec![std::fs::read(&path)?];
+        // Both compressed forms: packed, and the single zstd frame of earlier versions.
+        let corpus = vec![std::fs::read(&path)?, zstd::bulk::compress(&reference.to_bytes(), 3)?];
         let origin = Path::new("fuzz.bin");
         // Each accepted input inflates to 17.5 MB and is hashed: fewer inputs than the others.
         let report = fuzz(&corpus, 13, inputs(300), Focus::default(), |b| {

@@ -6,6 +6,7 @@ mod at_ks;
 mod codec;
 mod measures;
 mod modes;
+mod read;
 mod report;
 
 pub use at_ks::AtKs;
@@ -13,6 +14,7 @@ pub use codec::{Codec, FoldTraining, Method};
 pub use deepbrdf_data::mapping::MedianReference;
 pub use measures::{Measure, Original, Yardstick};
 pub use modes::{Fold, Mode};
+pub(crate) use read::{csv_rows, parsed};
 pub(crate) use report::csv_field;
 pub use report::{FitTiming, Record, Results};
 

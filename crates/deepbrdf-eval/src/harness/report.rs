@@ -201,7 +201,11 @@ impl Results {
             &dir.join("summary.md"),
             self.summary_markdown().as_bytes(),
         )?;
+        self.write_charts(dir)
+    }
 
+    /// Writes the plots into `dir`: error vs k and per material, one of each per measure.
+    pub fn write_charts(&self, dir: &Path) -> Result<()> {
         for &m in &self.measures {
             write_chart(&self.error_vs_k_chart(m), &dir.join(format!("error_vs_k_{}", m.name())))?;
             write_panels(
@@ -241,14 +245,34 @@ impl Results {
         }
     }
 
-    /// Fig. 7: per-material values of `measure`, one panel per k, one line per method; in each
-    /// panel the materials are sorted by the geometric mean of the methods' values at that k,
-    /// so the panel reads from the easiest material to the hardest and the lines can be compared
-    /// material by material.
+    /// The k at which every method was scored (all k if there is none): the k of the
+    /// per-material panels, where the methods can be compared (each method's values at every
+    /// k are in `results.csv`, its means in the tables and in error vs k).
+    pub fn shared_ks(&self) -> Vec<usize> {
+        let scored = |method: &String, k: usize| {
+            self.records.iter().any(|r| &r.method == method && r.k == k)
+        };
+        let shared: Vec<usize> = self
+            .ks
+            .iter()
+            .copied()
+            .filter(|&k| self.methods.iter().all(|m| scored(m, k)))
+            .collect();
+        if shared.is_empty() {
+            self.ks.clone()
+        } else {
+            shared
+        }
+    }
+
+    /// Fig. 7: per-material values of `measure`, one panel per k at which every method was
+    /// scored ([`Self::shared_ks`]), one line per method; in each panel the materials are
+    /// sorted by the geometric mean of the methods' values at that k, so the panel reads from
+    /// the easiest material to the hardest and the lines can be compared material by material.
     pub fn per_material_charts(&self, measure: Measure) -> Vec<LineChart> {
         let materials = self.materials();
         let width = (300 + 14 * materials.len() as u32).clamp(900, 2600);
-        self.ks
+        self.shared_ks()
             .iter()
             .map(|&k| {
                 let values: Vec<Vec<f64>> = self
@@ -311,7 +335,7 @@ pub(crate) fn csv_field(s: &str) -> String {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// Results shaped like a DeepBRDF sweep: 3 methods x 4 k x `n` materials, two measures.

@@ -6,7 +6,7 @@
 //! recovery/
 //!   recovery.json   id, network configuration, target (the DeepBRDF model id whose latent it
 //!                   predicts, or the 7 attributes), standardisation, provenance, weights checksum
-//!   weights.bpk     the network's parameters (burnpack)
+//!   weights.bpk     the network's parameters (burnpack), written packed as a model's are
 //! ```
 //!
 //! A network for one DeepBRDF model is refused for another ([`RecoveryArtifact::check_model`]):
@@ -22,7 +22,7 @@ use sha2::{Digest, Sha256};
 use super::network::{RecoveryConfig, RecoveryNet};
 use super::step::RecoveryTrained;
 use crate::artifact::{canonical, load_weights, part_of, save_dir, Part};
-use crate::atomic::{check_format, read_limited, write_atomic, write_manifest};
+use crate::atomic::{check_format, read_limited, read_weights, write_manifest, write_weights};
 use crate::error::{ModelError, Result};
 
 /// File name of the manifest.
@@ -206,7 +206,7 @@ impl RecoveryArtifact {
     }
 
     fn write_parts(&self, dir: &Path) -> Result<()> {
-        write_atomic(&dir.join(RECOVERY_WEIGHTS), &[&self.weights])?;
+        write_weights(&dir.join(RECOVERY_WEIGHTS), &self.weights)?;
         let manifest = Manifest {
             format: FORMAT.into(),
             version: VERSION,
@@ -250,7 +250,7 @@ impl RecoveryArtifact {
             ));
         }
         let weights_path = dir.join(RECOVERY_WEIGHTS);
-        let weights = read_limited(&weights_path, 1 << 30)?;
+        let weights = read_weights(&weights_path, 1 << 30)?;
         if part_of(&weights, RECOVERY_WEIGHTS) != manifest.weights {
             return Err(ModelError::mismatch(
                 &weights_path,

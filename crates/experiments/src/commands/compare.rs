@@ -14,7 +14,7 @@ use std::path::PathBuf;
 
 /// The RGL evaluator of `spec` (material `which`, A or B, for `flag`): a `.bsdf` file or
 /// `rgl-measured/NAME`.
-fn load_evaluator(spec: &str, which: &str, flag: &str) -> anyhow::Result<RglBrdf> {
+pub(crate) fn load_evaluator(spec: &str, which: &str, flag: &str) -> anyhow::Result<RglBrdf> {
     match spec.strip_prefix("rgl-measured/") {
         Some(name) => Ok(bundled::load(name)?),
         None if spec.ends_with(".bsdf") => Ok(RglBrdf::read(spec)?),

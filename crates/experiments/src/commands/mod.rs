@@ -5,6 +5,7 @@ use crate::progress::Bars;
 pub mod attributes;
 pub mod baselines;
 pub mod bench;
+pub mod compact;
 pub mod compare;
 pub mod convert;
 pub mod corpus;
@@ -26,6 +27,7 @@ pub mod reconstruct;
 pub mod recover;
 pub mod render;
 pub mod render_set;
+pub mod round_trip;
 pub mod serve;
 pub mod sheet;
 pub mod sweep_k;
@@ -45,6 +47,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Folds(args) => folds::run(args, &progress),
         Command::Tabulate(args) => tabulate::run(args, &progress),
         Command::PackNbrdf(args) => pack_nbrdf::run(args, &progress),
+        Command::Compact(args) => compact::run(args, &progress),
         Command::Corpus(args) => corpus::run(args, &progress),
         Command::Train(args) => train::run(args, &progress),
         Command::Encode(args) => encode::run(args, &progress),
@@ -55,6 +58,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Compare(args) => compare::run(args, &progress),
         Command::Convert(args) => convert::run(args, &progress),
         Command::ExportBsdf(args) => export_bsdf::run(args, &progress),
+        Command::RoundTrip(args) => round_trip::run(args, &progress),
         Command::Sheet(args) => sheet::run(args, &progress),
         Command::Serve(args) => serve::run(args, &progress),
         Command::Baselines(args) => baselines::run(args, &progress),

@@ -23,6 +23,7 @@ use deepbrdf_eval::deep::{DeepMethod, NAME};
 use deepbrdf_eval::figures::slices::{self as slices_figure, FIG2_MATERIAL};
 use deepbrdf_eval::harness::{self, AtKs, HarnessConfig, Materials, Measure, Mode};
 use deepbrdf_eval::robustness;
+use deepbrdf_eval::saved_sweep::SavedSweep;
 use deepbrdf_eval::sweep_report::{minutes, training_csv, SweepReport};
 use deepbrdf_model::{Preset, TrainConfig};
 use std::path::{Path, PathBuf};
@@ -101,6 +102,10 @@ pub struct Args {
     /// markdown file (e.g. README.md) with the results table and plots.
     #[arg(long, value_name = "FILE")]
     pub update_readme: Option<PathBuf>,
+    /// Train and evaluate nothing: redraw the charts of the finished run in DIR from its CSV
+    /// files and, with --update-readme, rewrite its block from them (its mode picks the block).
+    #[arg(long, value_name = "DIR")]
+    pub from: Option<PathBuf>,
 }
 
 impl Args {
@@ -165,6 +170,9 @@ impl Args {
 }
 
 pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
+    if let Some(dir) = &args.from {
+        return from_saved(dir, args.update_readme.as_deref());
+    }
     let started = Instant::now();
     let logged = ProgressLog::new(bars, quiet, Duration::from_secs(30));
     let progress: &dyn Progress = &logged;
@@ -280,6 +288,30 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// `--from DIR`: the charts of the run in `dir` redrawn and, with `readme`, its block
+/// rewritten, from the run's files.
+fn from_saved(dir: &Path, readme: Option<&Path>) -> anyhow::Result<()> {
+    let saved = SavedSweep::read(dir)?;
+    saved.results.write_charts(dir)?;
+    println!("redrew the charts of {} from its results.csv", dir.display());
+    if let Some(readme) = readme {
+        let (begin, end, block) = saved_block(&saved, readme, dir)?;
+        readme_block::update_file(readme, begin, end, &block)?;
+        println!("updated the results block of {}", readme.display());
+    }
+    Ok(())
+}
+
+/// The markers and the text of the block of `readme` for the run `saved` read from `dir`.
+pub fn saved_block(
+    saved: &SavedSweep,
+    readme: &Path,
+    dir: &Path,
+) -> anyhow::Result<(&'static str, &'static str, String)> {
+    let (begin, end) = readme_markers(saved.results.mode);
+    Ok((begin, end, saved.report().readme_block(&relative_link(readme, dir)?)))
+}
+
 /// The Fig. 2 picture for `--fig2-material` (skipped with a note when it is not in the data),
 /// at `k` (the first of the Fig. 2 k), by the model of the fold that evaluates it.
 fn fig2_picture(
@@ -340,7 +372,38 @@ fn relative_link(readme: &Path, out: &Path) -> anyhow::Result<String> {
 
 #[cfg(test)]
 mod tests {
-    use super::relative_link;
+    use super::*;
+
+    /// Every generated block of docs/results.md, regenerated from the committed results folder
+    /// it links to (its CSV files and summary, nothing retrained), is the block the file holds:
+    /// a block left stale by a rerun, an edit of the folder or of the generator fails here.
+    #[test]
+    fn the_generated_blocks_of_the_docs_match_their_committed_results() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let readme = root.join("docs/results.md");
+        let text = std::fs::read_to_string(&readme).unwrap();
+        let mut checked = 0;
+        for mode in [Mode::KFold { folds: 5 }, Mode::InSample, Mode::Generalize] {
+            let (begin, end) = readme_markers(mode);
+            let Some(start) = text.find(begin) else { continue };
+            let block = &text[start..text.find(end).unwrap()];
+            let details = block.lines().find_map(|l| l.strip_prefix("Details: [")).unwrap();
+            let folder = details.split_once("/summary.md]").unwrap().0;
+            let dir = readme.parent().unwrap().join(folder);
+            let saved = SavedSweep::read(&dir).unwrap();
+            let (b, e, fresh) = saved_block(&saved, &readme, &dir).unwrap();
+            assert_eq!((b, e), (begin, end), "{folder} holds a run of another mode");
+            let regenerated = readme_block::replace_block(&text, b, e, &fresh).unwrap();
+            assert!(
+                regenerated == text,
+                "the {begin} block of docs/results.md is stale: run `experiments sweep-k --from \
+                 {} --update-readme docs/results.md`",
+                folder.trim_start_matches("../")
+            );
+            checked += 1;
+        }
+        assert!(checked >= 1, "no generated block in docs/results.md");
+    }
 
     #[test]
     fn results_links_are_relative_to_the_markdown_files_folder() {

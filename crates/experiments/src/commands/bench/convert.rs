@@ -14,7 +14,7 @@ pub struct Args {
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let inputs: Vec<(String, Vec<u8>)> = if args.files.is_empty() {
-        bundled::FILES.iter().map(|(n, b)| (n.to_string(), b.to_vec())).collect()
+        bundled::files()?.into_iter().map(|(n, b)| (n.to_string(), b)).collect()
     } else {
         args.files
             .iter()
