@@ -193,6 +193,44 @@ impl Space<'_> {
     }
 }
 
+/// One material's edit as `experiments edit` and the Python package make it: `table` (whose
+/// attributes are `original`) edited by `edit` in `mode`, analytically (no network) or through
+/// `editor`, a DeepBRDF model and its regressor (eq. 7), encoding the table first when the mode
+/// needs its latent. An error when the mode needs a network and none is given.
+pub fn edit_material(
+    table: &MerlTable,
+    original: &Attributes,
+    edit: &Edit,
+    mode: EditMode,
+    editor: Option<(&DeepBrdf, &Regressor)>,
+) -> Result<Edited> {
+    match (mode.needs_network(), editor) {
+        (false, _) => {
+            let requested = edit.apply(original)?;
+            let table = analytic_edit(table, original, &requested)?;
+            Ok(Edited { requested, table })
+        }
+        (true, Some((model, regressor))) => {
+            let codec = ModelCodec(model);
+            let space = Space { codec: &codec, regressor };
+            let latent = match mode.needs_latent() {
+                true => codec.encode(table)?,
+                false => Vec::new(),
+            };
+            space.edit(table, &latent, original, edit, mode)
+        }
+        (true, None) => {
+            Err(EvalError::Invalid(format!("the {mode} edit needs a model and its regressor")))
+        }
+    }
+}
+
+/// The `steps` blend weights of an interpolation path, both ends included: `t = i / (steps -
+/// 1)` (Fig. 10).
+pub fn path_weights(steps: usize) -> Vec<f64> {
+    (0..steps).map(|i| i as f64 / (steps.max(2) - 1) as f64).collect()
+}
+
 /// `(1 - t) a + t b`.
 pub fn blend(a: &[f32], b: &[f32], t: f64) -> Vec<f32> {
     a.iter().zip(b).map(|(&x, &y)| ((1.0 - t) * f64::from(x) + t * f64::from(y)) as f32).collect()
