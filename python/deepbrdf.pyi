@@ -8,6 +8,7 @@ linear radiance, or (H, W, 4) with the coverage as fourth channel.
 """
 
 import os
+import pathlib
 from typing import Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -96,7 +97,7 @@ class Model:
     def id(self) -> str:
         """The model's id."""
     @property
-    def path(self) -> str:
+    def path(self) -> pathlib.Path:
         """The model directory."""
     def encode(self, table: ArrayLike) -> npt.NDArray[np.float32]:
         """Eq. (2): the latent vector (k,) of a table."""

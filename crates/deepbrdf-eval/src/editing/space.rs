@@ -254,6 +254,7 @@ pub fn blend_tables(a: &MerlTable, b: &MerlTable, t: f64) -> Result<MerlTable> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::editing::ScalarEdit;
     use deepbrdf_data::testing::synthetic_table;
 
     #[test]
@@ -264,6 +265,27 @@ mod tests {
         assert!("linear".parse::<EditMode>().unwrap_err().to_string().contains("analytic"));
         assert!(EditMode::LATENT.iter().all(|m| m.needs_network()));
         assert!(!EditMode::Analytic.needs_network() && !EditMode::Paper.needs_latent());
+    }
+
+    #[test]
+    fn path_weights_run_from_zero_to_one() {
+        assert_eq!(path_weights(5), vec![0.0, 0.25, 0.5, 0.75, 1.0]);
+        assert_eq!(path_weights(2), vec![0.0, 1.0]);
+    }
+
+    #[test]
+    fn a_material_edit_needs_a_network_unless_analytic() {
+        let table = synthetic_table(3);
+        let original = Attributes { diffuse: [0.3, 0.2, 0.1], specular: [0.05; 3], roughness: 0.1 };
+        let edit = Edit { roughness: Some(ScalarEdit::Scale(2.0)), ..Edit::default() };
+        let Err(err) = edit_material(&table, &original, &edit, EditMode::Residual, None) else {
+            panic!("a residual edit without a model was made");
+        };
+        assert!(err.to_string().contains("needs a model"), "{err}");
+        let analytic = edit_material(&table, &original, &edit, EditMode::Analytic, None).unwrap();
+        assert_eq!(analytic.requested.roughness, 0.2);
+        let direct = analytic_edit(&table, &original, &analytic.requested).unwrap();
+        assert_eq!(analytic.table, direct);
     }
 
     #[test]
