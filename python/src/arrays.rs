@@ -4,17 +4,16 @@
 //! float32 array of shape (k,); an image is float32 (H, W, 3) linear radiance, or (H, W, 4) with
 //! the coverage as the fourth channel.
 //!
-//! Arrays pass through Python's buffer protocol (PyO3's safe `PyBuffer`, and a `bytearray`
-//! that `numpy.frombuffer` wraps): one copy each way, between numpy's memory and the library's
-//! table, with invalid values turned into NaN (or back) on the way and the GIL released while
-//! the values are copied out.
+//! Arrays pass through Python's buffer protocol (PyO3's safe `PyBuffer`): one copy each way,
+//! between numpy's memory and the library's table; invalid values are turned into NaN (or back)
+//! in the library's buffer, in parallel, with the GIL released.
 use crate::errors::value_error;
 use deepbrdf_data::merl::{INVALID_VALUE, N_PHI_D, N_THETA_D, N_THETA_H, VALUES};
 use deepbrdf_data::MerlTable;
 use deepbrdf_render::Image;
 use pyo3::buffer::PyBuffer;
 use pyo3::prelude::*;
-use pyo3::types::{PyByteArray, PyDict};
+use pyo3::types::PyDict;
 use rayon::prelude::*;
 
 /// The shape of one table.
@@ -112,62 +111,47 @@ impl TableStack {
     }
 }
 
-/// A float32 numpy array of `shape` holding `values` (library values; with `nan_invalid`,
-/// negative ones, the invalid cells of tables, become NaN), copied once into a `bytearray`
-/// that numpy wraps (writable, no further copy), the GIL released while copying.
-pub fn array_out<'py>(
-    py: Python<'py>,
-    values: &[f32],
-    shape: &[usize],
-    nan_invalid: bool,
-) -> PyResult<Bound<'py, PyAny>> {
-    let bytes = PyByteArray::new_with(py, values.len() * 4, |out| {
-        py.detach(|| fill(out, values, nan_invalid));
-        Ok(())
-    })?;
-    wrap(py, bytes, shape)
-}
-
-/// Writes `values` into `out` as native float32 bytes, in parallel (negative values as NaN
-/// with `nan_invalid`).
-fn fill(out: &mut [u8], values: &[f32], nan_invalid: bool) {
-    out.par_chunks_mut(4 * CHUNK).zip(values.par_chunks(CHUNK)).for_each(|(o, v)| {
-        for (o, &v) in o.chunks_exact_mut(4).zip(v) {
-            let v = if nan_invalid && v < 0.0 { f32::NAN } else { v };
-            o.copy_from_slice(&v.to_ne_bytes());
+/// Invalid (negative) values of a table as NaN, in place, in parallel.
+fn nan_invalid(values: &mut [f32]) {
+    values.par_chunks_mut(CHUNK).for_each(|chunk| {
+        for v in chunk {
+            if *v < 0.0 {
+                *v = f32::NAN;
+            }
         }
     });
 }
 
-/// numpy's float32 view of `bytes`, reshaped (no copy).
-fn wrap<'py>(
+/// A new float32 numpy array of `shape` (`numpy.empty`) holding `values`, copied once through
+/// the buffer protocol.
+pub fn floats_out<'py>(
     py: Python<'py>,
-    bytes: Bound<'py, PyByteArray>,
+    values: &[f32],
     shape: &[usize],
 ) -> PyResult<Bound<'py, PyAny>> {
-    let kwargs = PyDict::new(py);
-    kwargs.set_item("dtype", "float32")?;
-    let flat = py.import("numpy")?.call_method("frombuffer", (bytes,), Some(&kwargs))?;
-    flat.call_method1("reshape", (shape.to_vec(),))
+    let array = py.import("numpy")?.call_method1("empty", (shape.to_vec(), "float32"))?;
+    PyBuffer::<f32>::get(&array)?.copy_from_slice(py, values)?;
+    Ok(array)
 }
 
-/// The numpy array of one table.
-pub fn table_out<'py>(py: Python<'py>, table: &MerlTable) -> PyResult<Bound<'py, PyAny>> {
-    array_out(py, table.values(), &TABLE_SHAPE, true)
+/// The numpy array of one table, invalid cells NaN.
+pub fn table_out(py: Python<'_>, table: MerlTable) -> PyResult<Bound<'_, PyAny>> {
+    let mut values = table.into_values();
+    py.detach(|| nan_invalid(&mut values));
+    floats_out(py, &values, &TABLE_SHAPE)
 }
 
-/// The numpy array (n, 3, 90, 90, 180) of a stack of tables, copied once.
-pub fn stack_out<'py>(py: Python<'py>, tables: &[MerlTable]) -> PyResult<Bound<'py, PyAny>> {
+/// The numpy array (n, 3, 90, 90, 180) of a stack of tables, invalid cells NaN.
+pub fn stack_out(py: Python<'_>, tables: Vec<MerlTable>) -> PyResult<Bound<'_, PyAny>> {
     let t = TABLE_SHAPE;
-    let bytes = PyByteArray::new_with(py, tables.len() * VALUES * 4, |out| {
-        py.detach(|| {
-            for (o, table) in out.chunks_exact_mut(VALUES * 4).zip(tables) {
-                fill(o, table.values(), true);
-            }
-        });
-        Ok(())
-    })?;
-    wrap(py, bytes, &[tables.len(), t[0], t[1], t[2], t[3]])
+    let shape = vec![tables.len(), t[0], t[1], t[2], t[3]];
+    let array = py.import("numpy")?.call_method1("empty", (shape, "float32"))?;
+    for (i, table) in tables.into_iter().enumerate() {
+        let mut values = table.into_values();
+        py.detach(|| nan_invalid(&mut values));
+        PyBuffer::<f32>::get(&array.get_item(i)?)?.copy_from_slice(py, &values)?;
+    }
+    Ok(array)
 }
 
 /// A latent vector, shape (k,).
@@ -229,5 +213,5 @@ pub fn image_out<'py>(py: Python<'py>, image: &Image, alpha: bool) -> PyResult<B
             values.push(a);
         }
     }
-    array_out(py, &values, &[h, w, c], false)
+    floats_out(py, &values, &[h, w, c])
 }

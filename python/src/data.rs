@@ -19,7 +19,7 @@ use std::path::PathBuf;
 #[pyfunction]
 pub fn read_merl(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyAny>> {
     let table = py.detach(|| deepbrdf_data::merl::read_merl(&path)).map_err(py_err)?;
-    table_out(py, &table)
+    table_out(py, table)
 }
 
 /// write_merl(path, table) -> None
@@ -41,7 +41,7 @@ pub fn write_merl(py: Python<'_>, path: PathBuf, table: &Bound<'_, PyAny>) -> Py
 pub fn read_bsdf(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyAny>> {
     let table =
         py.detach(|| RglBrdf::read(&path).and_then(|brdf| tabulate(&brdf))).map_err(py_err)?;
-    table_out(py, &table)
+    table_out(py, table)
 }
 
 /// bundled(name) -> numpy.ndarray
@@ -56,7 +56,7 @@ pub fn read_bsdf(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyAny>> {
 pub fn bundled<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
     let (_, table) =
         py.detach(|| load_bundled_material(name, &Cache::default_location())).map_err(py_err)?;
-    table_out(py, &table)
+    table_out(py, table)
 }
 
 /// bundled_names(collection=None) -> list[str]

@@ -4,7 +4,7 @@
 //! makes. Every call releases the GIL while it computes; the batch forms and interpolation
 //! check for Ctrl-C between tables.
 use crate::arrays::{
-    array_out, image_in, latent_in, latents_in, stack_out, table_in, table_out, TableStack,
+    floats_out, image_in, latent_in, latents_in, stack_out, table_in, table_out, TableStack,
 };
 use crate::errors::{py_err, value_error};
 use deepbrdf_data::MerlTable;
@@ -179,7 +179,7 @@ impl Model {
     ) -> PyResult<Bound<'py, PyAny>> {
         let table = table_in(table, "table")?;
         let latent = py.detach(|| self.model.encode(&table)).map_err(py_err)?;
-        array_out(py, &latent, &[latent.len()], false)
+        floats_out(py, &latent, &[latent.len()])
     }
 
     /// encode_batch(tables) -> numpy.ndarray
@@ -197,7 +197,7 @@ impl Model {
             rows.extend(py.detach(|| self.model.encode(&table)).map_err(py_err)?);
             py.check_signals()?;
         }
-        array_out(py, &rows, &[stack.len(), self.model.k()], false)
+        floats_out(py, &rows, &[stack.len(), self.model.k()])
     }
 
     /// decode(latent) -> numpy.ndarray
@@ -211,7 +211,7 @@ impl Model {
     ) -> PyResult<Bound<'py, PyAny>> {
         let latent = latent_in(latent, "latent")?;
         let table = self.decode_table(py, &latent)?;
-        table_out(py, &table)
+        table_out(py, table)
     }
 
     /// decode_batch(latents) -> numpy.ndarray
@@ -228,7 +228,7 @@ impl Model {
             tables.push(self.decode_table(py, row)?);
             py.check_signals()?;
         }
-        stack_out(py, &tables)
+        stack_out(py, tables)
     }
 
     /// reconstruct(table) -> numpy.ndarray
@@ -241,7 +241,7 @@ impl Model {
     ) -> PyResult<Bound<'py, PyAny>> {
         let table = table_in(table, "table")?;
         let out = py.detach(|| self.model.reconstruct(&table)).map_err(py_err)?;
-        table_out(py, &out)
+        table_out(py, out)
     }
 
     /// reconstruct_batch(tables) -> numpy.ndarray
@@ -259,7 +259,7 @@ impl Model {
             out.push(py.detach(|| self.model.reconstruct(&table)).map_err(py_err)?);
             py.check_signals()?;
         }
-        stack_out(py, &out)
+        stack_out(py, out)
     }
 
     /// edit(table, *, diffuse=None, diffuse_scale=None, specular=None, specular_scale=None,
@@ -314,7 +314,7 @@ impl Model {
                 edit_material(&table, &original, &edit, mode, editor)
             })
             .map_err(py_err)?;
-        table_out(py, &edited.table)
+        table_out(py, edited.table)
     }
 
     /// interpolate(a, b, steps=9) -> numpy.ndarray
@@ -342,7 +342,7 @@ impl Model {
             py.check_signals()?;
             tables.push(self.decode_table(py, &blend(&za, &zb, t))?);
         }
-        stack_out(py, &tables)
+        stack_out(py, tables)
     }
 
     /// recover(image) -> numpy.ndarray
@@ -367,7 +367,7 @@ impl Model {
             let latent = latents.pop().ok_or_else(|| value_error("no latent predicted"))?;
             self.model.decode(&latent).map_err(py_err)
         })?;
-        table_out(py, &table)
+        table_out(py, table)
     }
 
     /// library_decode_seconds(latent, repeats=10) -> list[float]
