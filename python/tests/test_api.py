@@ -84,6 +84,11 @@ def test_render_recover_and_relae(model, chrome, tmp_path):
     from_array = model.recover(image)
     np.testing.assert_array_equal(from_file, from_array)
     assert from_array.shape == (3, 90, 90, 180)
+    # An 8-bit sRGB photo (as a camera gives) works too.
+    srgb = (np.clip(image[..., :3], 0, 1) ** (1 / 2.2) * 255 + 0.5).astype(np.uint8)
+    assert model.recover(srgb).shape == (3, 90, 90, 180)
+    with pytest.raises(ValueError, match="uint8"):
+        model.recover(srgb[..., :2])
     with pytest.raises(ValueError):
         model.recover(np.zeros((64, 64, 3), dtype=np.float32))
 
