@@ -29,8 +29,7 @@ pub struct EditorArg {
     pub regressor: Option<PathBuf>,
 }
 
-/// Name of the folder holding a model's regressors, inside the model directory.
-pub const REGRESSOR_DIR: &str = "regressor";
+pub use deepbrdf_model::shipped::REGRESSOR_DIR;
 
 /// The `--mode` option's parser for `modes` ([`EditMode::ALL`], or [`EditMode::LATENT`] where the
 /// edit has to be a latent).

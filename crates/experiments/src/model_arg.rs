@@ -6,11 +6,7 @@
 use anyhow::bail;
 use std::path::{Path, PathBuf};
 
-/// The shipped default model, `models/default/` at the repository root: the training directory
-/// of `experiments train --preset slice` (the autoencoder artifact in `model/`, its log and
-/// configuration), with the networks trained for it beside it (`regressor/` for editing,
-/// `recovery/` for single-image recovery).
-pub const DEFAULT_MODEL_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../models/default");
+pub use deepbrdf_model::DEFAULT_MODEL_DIR;
 
 #[derive(Debug, Clone, clap::Args)]
 pub struct ModelArg {

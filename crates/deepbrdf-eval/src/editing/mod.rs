@@ -29,4 +29,7 @@ pub use measures::{
     EditOutcome, Plausibility,
 };
 pub use request::{ColourEdit, Edit, EditedAttribute, ScalarEdit};
-pub use space::{blend, blend_tables, EditMode, Edited, ModelCodec, Space, DEFAULT_MODE};
+pub use space::{
+    blend, blend_tables, edit_material, path_weights, EditMode, Edited, ModelCodec, Space,
+    DEFAULT_MODE,
+};

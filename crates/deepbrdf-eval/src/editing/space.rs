@@ -193,6 +193,44 @@ impl Space<'_> {
     }
 }
 
+/// One material's edit as `experiments edit` and the Python package make it: `table` (whose
+/// attributes are `original`) edited by `edit` in `mode`, analytically (no network) or through
+/// `editor`, a DeepBRDF model and its regressor (eq. 7), encoding the table first when the mode
+/// needs its latent. An error when the mode needs a network and none is given.
+pub fn edit_material(
+    table: &MerlTable,
+    original: &Attributes,
+    edit: &Edit,
+    mode: EditMode,
+    editor: Option<(&DeepBrdf, &Regressor)>,
+) -> Result<Edited> {
+    match (mode.needs_network(), editor) {
+        (false, _) => {
+            let requested = edit.apply(original)?;
+            let table = analytic_edit(table, original, &requested)?;
+            Ok(Edited { requested, table })
+        }
+        (true, Some((model, regressor))) => {
+            let codec = ModelCodec(model);
+            let space = Space { codec: &codec, regressor };
+            let latent = match mode.needs_latent() {
+                true => codec.encode(table)?,
+                false => Vec::new(),
+            };
+            space.edit(table, &latent, original, edit, mode)
+        }
+        (true, None) => {
+            Err(EvalError::Invalid(format!("the {mode} edit needs a model and its regressor")))
+        }
+    }
+}
+
+/// The `steps` blend weights of an interpolation path, both ends included: `t = i / (steps -
+/// 1)` (Fig. 10).
+pub fn path_weights(steps: usize) -> Vec<f64> {
+    (0..steps).map(|i| i as f64 / (steps.max(2) - 1) as f64).collect()
+}
+
 /// `(1 - t) a + t b`.
 pub fn blend(a: &[f32], b: &[f32], t: f64) -> Vec<f32> {
     a.iter().zip(b).map(|(&x, &y)| ((1.0 - t) * f64::from(x) + t * f64::from(y)) as f32).collect()
@@ -216,6 +254,7 @@ pub fn blend_tables(a: &MerlTable, b: &MerlTable, t: f64) -> Result<MerlTable> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::editing::ScalarEdit;
     use deepbrdf_data::testing::synthetic_table;
 
     #[test]
@@ -226,6 +265,27 @@ mod tests {
         assert!("linear".parse::<EditMode>().unwrap_err().to_string().contains("analytic"));
         assert!(EditMode::LATENT.iter().all(|m| m.needs_network()));
         assert!(!EditMode::Analytic.needs_network() && !EditMode::Paper.needs_latent());
+    }
+
+    #[test]
+    fn path_weights_run_from_zero_to_one() {
+        assert_eq!(path_weights(5), vec![0.0, 0.25, 0.5, 0.75, 1.0]);
+        assert_eq!(path_weights(2), vec![0.0, 1.0]);
+    }
+
+    #[test]
+    fn a_material_edit_needs_a_network_unless_analytic() {
+        let table = synthetic_table(3);
+        let original = Attributes { diffuse: [0.3, 0.2, 0.1], specular: [0.05; 3], roughness: 0.1 };
+        let edit = Edit { roughness: Some(ScalarEdit::Scale(2.0)), ..Edit::default() };
+        let Err(err) = edit_material(&table, &original, &edit, EditMode::Residual, None) else {
+            panic!("a residual edit without a model was made");
+        };
+        assert!(err.to_string().contains("needs a model"), "{err}");
+        let analytic = edit_material(&table, &original, &edit, EditMode::Analytic, None).unwrap();
+        assert_eq!(analytic.requested.roughness, 0.2);
+        let direct = analytic_edit(&table, &original, &analytic.requested).unwrap();
+        assert_eq!(analytic.table, direct);
     }
 
     #[test]

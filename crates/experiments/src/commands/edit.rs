@@ -5,14 +5,14 @@
 //! (eq. 7) and decoder (eq. 3), or analytically without a network, writes the edited MERL
 //! table, and prints the attributes asked for and those re-estimated on the result.
 use crate::data_args::CacheArg;
-use crate::editing::{self, EditMode, EditorArg, ModelCodec, Space, DEFAULT_MODE};
+use crate::editing::{self, EditMode, EditorArg, DEFAULT_MODE};
 use crate::scene_args::SceneArgs;
 use anyhow::{bail, Context};
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::merl::write_merl;
 use deepbrdf_data::Progress;
 use deepbrdf_eval::attributes::{Attributes, FitConfig};
-use deepbrdf_eval::editing::{analytic_edit, Edited};
+use deepbrdf_eval::editing::edit_material;
 use deepbrdf_eval::editing::{ColourEdit, Edit, ScalarEdit};
 use deepbrdf_render::{render, MerlBrdf};
 use std::path::PathBuf;
@@ -136,23 +136,14 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     edit.apply(&original).with_context(|| format!("editing {name}"))?;
     let mode = args.mode.unwrap_or(DEFAULT_MODE);
     let (edited, by) = match mode.needs_network() {
-        false => {
-            let requested = edit.apply(&original)?;
-            let table = analytic_edit(&table, &original, &requested)?;
-            (Edited { requested, table }, "no network".to_string())
-        }
+        false => (edit_material(&table, &original, &edit, mode, None)?, "no network".to_string()),
         true => {
             let device = crate::device_arg::device()?;
             let model_dir = args.editor.model.dir()?;
             let (model, regressor) =
                 editing::load_editor(&model_dir, args.editor.regressor.as_deref(), &device)?;
-            let codec = ModelCodec(&model);
-            let space = Space { codec: &codec, regressor: &regressor };
-            let latent = match mode.needs_latent() {
-                true => model.encode(&table)?,
-                false => Vec::new(),
-            };
-            (space.edit(&table, &latent, &original, &edit, mode)?, format!("model {}", model.id()))
+            let edited = edit_material(&table, &original, &edit, mode, Some((&model, &regressor)))?;
+            (edited, format!("model {}", model.id()))
         }
     };
     write_merl(&edited.table, &args.output)?;

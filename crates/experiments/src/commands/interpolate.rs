@@ -12,7 +12,7 @@ use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::merl::write_merl;
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::baseline::{BaselineBasis, MappingKind};
-use deepbrdf_eval::editing::{coefficient_of_variation, plausibility};
+use deepbrdf_eval::editing::{coefficient_of_variation, path_weights, plausibility};
 use deepbrdf_eval::harness::Codec;
 use deepbrdf_eval::metrics::{relae, ImageRelae, ImageRelaeConfig};
 use deepbrdf_model::DeepBrdf;
@@ -115,7 +115,7 @@ pub fn paths(
     progress: &dyn Progress,
 ) -> anyhow::Result<Vec<Path3>> {
     let reference = ImageRelae::new(a, &ImageRelaeConfig::default())?;
-    let ts: Vec<f64> = (0..steps).map(|i| i as f64 / (steps - 1) as f64).collect();
+    let ts = path_weights(steps);
     let deep = ModelCodec(model);
     let mut codecs: Vec<&dyn Codec> = vec![&deep];
     codecs.extend(ipca);
