@@ -200,12 +200,13 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let (fig5, labelled) = draw_scatter(&plot)?;
     fig5.write_png(&args.out.join("fig5.png"))?;
     let mut csv5 = String::from("material,pc1,pc2,labelled");
-    (0..k).for_each(|j| write!(csv5, ",z{j}").unwrap_or(()));
+    for j in 0..k {
+        write!(csv5, ",z{j}")?;
+    }
     csv5.push('\n');
-    for i in 0..n {
-        let [x, y] = plane.coords[i];
+    for (i, (latent, [x, y])) in latents.iter().zip(&plane.coords).enumerate() {
         write!(csv5, "{},{x:.6},{y:.6},{}", set.names[i], labelled.contains(&i))?;
-        for z in &latents[i] {
+        for z in latent {
             write!(csv5, ",{z:.6}")?;
         }
         csv5.push('\n');
