@@ -13,13 +13,7 @@ fn figures_generalize_writes_fig9_with_both_methods_relae() {
         deepbrdf_data::merl::write_merl(&util::material(i), shown.join(format!("n{i}.binary")))
             .unwrap();
     }
-    let config_path = util::tiny_config(dir.path());
-    let model = dir.path().join("model");
-    let o = util::run_in(
-        dir.path(),
-        &["train", "--config", &s(&config_path), "--data", &s(&data), "--out", &s(&model)],
-    );
-    assert!(o.status.success(), "{}", util::stderr(&o));
+    let model = util::train_tiny(dir.path(), &data);
 
     let out = dir.path().join("fig9");
     let args = ["figures-generalize", "--model", &s(&model), "--data", &s(&shown)];

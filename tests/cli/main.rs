@@ -14,6 +14,7 @@ mod generalize;
 mod kill;
 mod mitsuba;
 mod model;
+mod quality;
 mod recovery;
 mod reliability;
 mod render;

@@ -34,6 +34,19 @@ pub fn tiny_config(dir: &Path) -> std::path::PathBuf {
     path
 }
 
+/// Trains a model with [`tiny_config`] on the materials in `data` into `dir/model` (asserting
+/// that training succeeds) and returns that folder.
+pub fn train_tiny(dir: &Path, data: &Path) -> std::path::PathBuf {
+    let config_path = tiny_config(dir);
+    let model = dir.join("model");
+    let o = run_in(
+        dir,
+        &["train", "--config", &s(&config_path), "--data", &s(data), "--out", &s(&model)],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    model
+}
+
 /// Runs `experiments` with `args` in `cwd` (quiet), returning its output.
 pub fn run_in(cwd: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_experiments"))

@@ -84,6 +84,20 @@ impl Image {
         Ok(mean)
     }
 
+    /// The coverage-weighted mean radiance of the pixels the object covers (a material's colour
+    /// as a swatch; the sum of `coverage * radiance` over the sum of coverage), `None` where no
+    /// pixel shows the object.
+    pub fn object_mean(&self) -> Option<[f32; 3]> {
+        let (mut sum, mut weight) = ([0f64; 3], 0f64);
+        for (p, &c) in self.rgb.iter().zip(&self.coverage) {
+            if c > 0.0 {
+                (0..3).for_each(|k| sum[k] += f64::from(c) * f64::from(p[k]));
+                weight += f64::from(c);
+            }
+        }
+        (weight > 0.0).then(|| sum.map(|s| (s / weight) as f32))
+    }
+
     pub(crate) fn buffers_mut(&mut self) -> (&mut [[f32; 3]], &mut [f32]) {
         (&mut self.rgb, &mut self.coverage)
     }
@@ -214,6 +228,11 @@ impl Tonemap {
     #[inline]
     pub fn display(&self, v: f32) -> f32 {
         linear_to_srgb(self.apply(v))
+    }
+
+    /// A linear RGB radiance as an 8-bit sRGB colour (as [`Image::to_srgb8`] encodes a pixel).
+    pub fn srgb8(&self, rgb: [f32; 3]) -> [u8; 3] {
+        rgb.map(|v| encode_srgb8(self.apply(v)))
     }
 }
 
@@ -350,6 +369,21 @@ pub fn false_colour(t: f32) -> [u8; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn object_mean_weights_by_coverage_and_srgb8_encodes_like_a_pixel() {
+        // Pixels 0 (coverage 1) and 1 (0.5) are on the object, pixel 2 is not:
+        // (1 * 0.2 + 0.5 * 0.8) / 1.5 = 0.4 in every channel.
+        let image =
+            Image::from_pixels(3, 1, vec![[0.2; 3], [0.8; 3], [9.0; 3]], vec![1.0, 0.5, 0.0])
+                .unwrap();
+        let mean = image.object_mean().unwrap();
+        assert!(mean.iter().all(|v| (v - 0.4).abs() < 1e-6), "{mean:?}");
+        assert_eq!(Image::black(2, 2).object_mean(), None);
+        let t = Tonemap::default();
+        let one = Image::from_pixels(1, 1, vec![[0.4, 0.0, 2.0]], vec![1.0]).unwrap();
+        assert_eq!(t.srgb8([0.4, 0.0, 2.0]).to_vec(), one.to_srgb8(&t, [0; 3]).data);
+    }
 
     #[test]
     fn upscaling_repeats_each_pixel_in_a_block() {

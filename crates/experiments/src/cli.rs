@@ -98,6 +98,9 @@ pub enum Command {
     /// Fig. 9: materials no representation was fitted to (default: the real RGL measurements),
     /// as measured, as DeepBRDF and as IPCA reconstruct them, with the image RelAE of each.
     FiguresGeneralize(commands::figures_generalize::Args),
+    /// Figs. 5 and 6: the materials' latents in their principal plane, and a few materials
+    /// reconstructed by DeepBRDF, PCA and IPCA at several k, with the image RelAE of each.
+    FiguresQuality(commands::figures_quality::Args),
     /// The editing figures (Figs. 10, 12, 13, 14) and the measured edit suite.
     FiguresEditing(commands::figures_editing::Args),
     /// Edits against known answers: analytic corpus materials edited by the analytic edit,

@@ -1,9 +1,14 @@
 //! Figures of results: line charts (error vs k, per-material error) as compact SVG
-//! ([`compact`]), and the picture of Fig. 2 (phi_d slices of a BRDF and of its reconstructions,
-//! [`slices`]).
+//! ([`compact`]), the picture of Fig. 2 (phi_d slices of a BRDF and of its reconstructions,
+//! [`slices`]), and Fig. 5's latent plane ([`latent_plane`]) drawn as a scatter plot of
+//! materials ([`scatter`]).
 pub mod compact;
+pub mod latent_plane;
 mod plots;
+pub mod scatter;
 pub mod slices;
 
 pub use compact::compact_svg;
+pub use latent_plane::LatentPlane;
 pub use plots::{write_chart, write_panels, LineChart, Series};
+pub use scatter::{draw_scatter, ScatterPlot, ScatterPoint};

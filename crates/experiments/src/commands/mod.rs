@@ -18,6 +18,7 @@ pub mod export_bsdf;
 pub mod fetch_merl;
 pub mod figures_editing;
 pub mod figures_generalize;
+pub mod figures_quality;
 pub mod figures_recovery;
 pub mod folds;
 pub mod info;
@@ -69,6 +70,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::FiguresEditing(args) => figures_editing::run(args, &progress),
         Command::EditKnown(args) => edit_known::run(args, &progress),
         Command::FiguresGeneralize(args) => figures_generalize::run(args, &progress),
+        Command::FiguresQuality(args) => figures_quality::run(args, &progress),
         Command::RenderSet(args) => render_set::run(args, &progress),
         Command::TrainRecovery(args) => train_recovery::run(args, &progress),
         Command::Recover(args) => recover::run(args, &progress),
