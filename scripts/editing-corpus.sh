@@ -11,6 +11,8 @@
 #
 # Writes WORK/corpus-N/{known,heldout}/results.md and copies them into
 # results/editing-corpus/corpus-N/. NR (default 1000) bounds the regressor's corpus materials.
+# HELD_PASSES=P (default 1) trains with P passes over the measured materials per epoch against
+# one over the corpus (`train --held-passes`), into corpus-N-heldP.
 # Every step resumes: run it again after an interruption. Set EXPERIMENTS to a built binary to
 # skip `cargo run`.
 set -euo pipefail
@@ -19,6 +21,9 @@ shift || true
 sizes=(0 3000)
 [[ $# -gt 0 ]] && sizes=("$@")
 nr="${NR:-1000}"
+passes="${HELD_PASSES:-1}"
+suffix=""
+(( passes > 1 )) && suffix="-held$passes"
 cd "$(dirname "$0")/.."
 source scripts/experiments.sh
 mkdir -p "$work"
@@ -38,7 +43,7 @@ if (( largest > 0 )) && [[ ! -f "$work/corpus/corpus.jsonl" ]]; then
     run corpus --count "$largest" --seed 0 --out "$work/corpus" -q
 fi
 for n in "${sizes[@]}"; do
-    dir="$work/corpus-$n"
+    dir="$work/corpus-$n$suffix"
     corpus=()
     regressor_corpus=()
     if (( n > 0 )); then
@@ -49,7 +54,8 @@ for n in "${sizes[@]}"; do
         if [[ -f "$dir/model/checkpoint.bin" ]]; then
             run train --resume "$dir/model" -q
         else
-            run train --preset slice --k 10 --data "$work/merl80" "${corpus[@]}" --out "$dir/model" -q
+            run train --preset slice --k 10 --data "$work/merl80" "${corpus[@]}" --held-passes "$passes" \
+                --out "$dir/model" -q
         fi
     fi
     [[ -d "$dir/regressor" ]] || run train-regressor --model "$dir/model" --data "$work/merl80" \
@@ -58,8 +64,9 @@ for n in "${sizes[@]}"; do
         --count 70 --methods analytic,deepbrdf-residual,deepbrdf-transfer --out "$dir/known" -q
     [[ -f "$dir/heldout/results.md" ]] || run figures-editing --model "$dir/model" \
         --regressor "$dir/regressor" --data "$work/merl20" --every 1 --no-figures --out "$dir/heldout" -q
-    mkdir -p "results/editing-corpus/corpus-$n/known" "results/editing-corpus/corpus-$n/heldout"
-    cp "$dir/known/results.md" "$dir/known/known.csv" "results/editing-corpus/corpus-$n/known/"
-    cp "$dir/heldout/results.md" "$dir/heldout/suite.csv" "results/editing-corpus/corpus-$n/heldout/"
+    results="results/editing-corpus/$(basename "$dir")"
+    mkdir -p "$results/known" "$results/heldout"
+    cp "$dir/known/results.md" "$dir/known/known.csv" "$results/known/"
+    cp "$dir/heldout/results.md" "$dir/heldout/suite.csv" "$results/heldout/"
 done
 echo "results in results/editing-corpus"

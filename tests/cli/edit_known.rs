@@ -1,4 +1,4 @@
-//! `train --corpus`, `train-regressor --corpus` and `edit-known` end to end with a tiny model on
+//! `train --corpus [--held-passes N]`, `train-regressor --corpus` and `edit-known` end to end with a tiny model on
 //! three synthetic materials and a few corpus materials: the corpus materials join the training
 //! set, and every known-answer edit is scored for each of the seven methods, the analytic edit
 //! ending nearer the answer than the unedited material.
@@ -28,10 +28,33 @@ fn corpus_training_and_known_answer_edits() {
         &file,
         "--corpus-count",
         "2",
+        "--held-passes",
+        "2",
         "--out",
         &s(&run),
     ]);
     assert!(err.contains("(5 BRDFs)") && err.contains("corpus(2 of corpus.jsonl)"), "{err}");
+    let saved = std::fs::read_to_string(run.join("train_config.json")).unwrap();
+    assert!(saved.contains("\"held_passes\": 2"), "{saved}");
+    let refused = util::run_in(
+        dir.path(),
+        &[
+            "train",
+            "--config",
+            &s(&config),
+            "--data",
+            &s(&data),
+            "--held-passes",
+            "0",
+            "--out",
+            &s(&dir.path().join("r0")),
+        ],
+    );
+    let message = util::stderr(&refused);
+    assert!(
+        !refused.status.success() && message.contains("passes over the held samples"),
+        "{message}"
+    );
     let model = s(&run);
     ok(&[
         "train-regressor",

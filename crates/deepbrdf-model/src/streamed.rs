@@ -264,6 +264,22 @@ mod tests {
         };
         let (without, with) = (mean(&plain.model), mean(&streamed.model));
         assert!(with < 0.8 * without, "corpus MSE {with} streamed vs {without} not");
+        // More passes over the held BRDFs weigh them against the stream: they end better
+        // represented. One pass is written as before the setting existed.
+        let held_mean = |t: &crate::train::Trained| {
+            t.per_material_mse.iter().sum::<f64>() / t.per_material_mse.len() as f64
+        };
+        let json = serde_json::to_string(&config).expect("json");
+        assert!(!json.contains("held_passes"), "{json}");
+        let mut weighted = config.clone();
+        if let Architecture::Slice(layers) = &mut weighted.model.architecture {
+            layers.augmentation.held_passes = 4;
+        }
+        assert!(serde_json::to_string(&weighted).expect("json").contains("\"held_passes\":4"));
+        let c = tempfile::tempdir().expect("c");
+        let heavier = train(&weighted, &with_stream, c.path(), false, &Silent, &device).expect("4");
+        let (one, four) = (held_mean(&streamed), held_mean(&heavier));
+        assert!(four < 0.8 * one, "held MSE {four} with 4 passes vs {one} with 1");
         // A finished run resumed with other data is refused, not silently re-used.
         let err = train(&config, &set, b.path(), true, &Silent, &device).expect_err("other data");
         assert!(err.to_string().contains("data"), "{err}");

@@ -10,6 +10,7 @@ use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::lock::FolderLock;
 use deepbrdf_data::Progress;
+use deepbrdf_model::autoencoder::Architecture;
 use deepbrdf_model::train::{checkpoint_path, saved_config};
 use deepbrdf_model::{fit, Preset, SliceDropoutConfig, TrainConfig};
 use std::path::PathBuf;
@@ -48,6 +49,11 @@ pub struct Args {
     /// Slice selections drawn from for slice dropout (every:N or random:K, comma-separated).
     #[arg(long, value_name = "LIST", value_delimiter = ',', default_value = "every:3,every:9")]
     pub slice_dropout_keep: Vec<String>,
+    /// Passes over the held samples (the data's BRDFs and their augmentations) per epoch
+    /// against one over a streamed --corpus, and their weight in the fit of the principal
+    /// components (slice network) [default: 1].
+    #[arg(long, value_name = "N")]
+    pub held_passes: Option<usize>,
     /// Output directory (checkpoint, log, configuration, and the model in DIR/model).
     #[arg(long, value_name = "DIR", required_unless_present = "resume")]
     pub out: Option<PathBuf>,
@@ -102,6 +108,14 @@ impl Args {
                     .with_probability(p)
                     .with_selections(self.slice_dropout_keep.clone()),
             );
+        }
+        if let Some(passes) = self.held_passes {
+            match &mut config.model.architecture {
+                Architecture::Slice(layers) => layers.augmentation.held_passes = passes,
+                Architecture::Convolutional(_) => {
+                    bail!("--held-passes is a setting of the slice network, not of this one")
+                }
+            }
         }
         config.validate()?;
         Ok(config)

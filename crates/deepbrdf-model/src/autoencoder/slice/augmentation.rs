@@ -35,9 +35,9 @@ pub const FLOOR_QUANTILE: f64 = 0.1;
 pub const FLOOR_SCALES: (f64, f64) = (1.0 / 16.0, 1.5);
 
 /// Which extra BRDFs a training set is augmented with, and how its samples weigh in the loss.
-/// Every field has a default (none), so a configuration written before a field existed still
-/// loads.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+/// Every field has a default (none; one pass), so a configuration written before a field
+/// existed still loads, and one that leaves `held_passes` at 1 is written as before.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct AugmentationConfig {
     /// Add every BRDF in the 5 other orders of its colour channels.
@@ -49,6 +49,28 @@ pub struct AugmentationConfig {
     /// P of the image-space weighting of each sample's colour channels in the training loss
     /// ([`crate::loss::colour_weights`]; 0: eq. (4)'s unweighted error).
     pub image_weight_power: f64,
+    /// Passes over the held samples (the set's BRDFs and their augmentations) per epoch, against
+    /// one over the streamed BRDFs; the held samples weigh as much in the fit of the principal
+    /// components. A generated corpus streamed beside a few measured BRDFs otherwise outweighs
+    /// them in the loss and in the components.
+    #[serde(skip_serializing_if = "is_one")]
+    pub held_passes: usize,
+}
+
+fn is_one(passes: &usize) -> bool {
+    *passes == 1
+}
+
+impl Default for AugmentationConfig {
+    fn default() -> Self {
+        Self {
+            rgb_permutations: false,
+            mixtures_per_brdf: 0.0,
+            floors_per_brdf: 0.0,
+            image_weight_power: 0.0,
+            held_passes: 1,
+        }
+    }
 }
 
 /// One augmented sample.
@@ -91,6 +113,11 @@ impl AugmentationConfig {
         Self { image_weight_power, ..self }
     }
 
+    /// With this many passes over the held samples per epoch.
+    pub fn with_held_passes(self, held_passes: usize) -> Self {
+        Self { held_passes, ..self }
+    }
+
     /// The `slice` preset's: permutations and 4 mixtures per BRDF.
     pub fn preset() -> Self {
         Self::new().with_rgb_permutations(true).with_mixtures_per_brdf(4.0)
@@ -106,6 +133,12 @@ impl AugmentationConfig {
                     "{count} {what} per BRDF is out of range (0 to 100)"
                 )));
             }
+        }
+        if !(1..=100).contains(&self.held_passes) {
+            return Err(ModelError::Invalid(format!(
+                "{} passes over the held samples is out of range (1 to 100)",
+                self.held_passes
+            )));
         }
         if !(0.0..=2.0).contains(&self.image_weight_power) {
             return Err(ModelError::Invalid(format!(

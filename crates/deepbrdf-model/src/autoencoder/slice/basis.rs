@@ -167,6 +167,17 @@ pub struct Components {
 
 /// The mean and `k` leading principal directions of `vectors` (all of one length).
 pub fn fit_components(vectors: &[Vec<f32>], k: usize) -> Result<Components> {
+    fit_weighted_components(vectors, &vec![1.0; vectors.len()], k)
+}
+
+/// The weighted mean and `k` leading principal directions of `vectors`, vector i counted
+/// `weights[i]` times (positive weights): the principal directions of the centred vectors
+/// scaled by `sqrt(weights[i])`.
+pub fn fit_weighted_components(
+    vectors: &[Vec<f32>],
+    weights: &[f64],
+    k: usize,
+) -> Result<Components> {
     let n = vectors.len();
     let len = vectors.first().map_or(0, Vec::len);
     if n == 0 || k == 0 || vectors.iter().any(|v| v.len() != len) {
@@ -174,20 +185,28 @@ pub fn fit_components(vectors: &[Vec<f32>], k: usize) -> Result<Components> {
             "principal components (k = {k}) of {n} coefficient vectors of unequal or no length"
         )));
     }
+    if weights.len() != n || weights.iter().any(|w| !(w.is_finite() && *w > 0.0)) {
+        return Err(ModelError::Invalid(format!(
+            "principal components of {n} vectors need {n} positive weights ({} given)",
+            weights.len()
+        )));
+    }
     let mut mean = vec![0f64; len];
-    for v in vectors {
+    for (v, &w) in vectors.iter().zip(weights) {
         for (m, &x) in mean.iter_mut().zip(v) {
-            *m += f64::from(x);
+            *m += w * f64::from(x);
         }
     }
-    let mean: Vec<f32> = mean.iter().map(|&m| (m / n as f64) as f32).collect();
+    let total: f64 = weights.iter().sum();
+    let mean: Vec<f32> = mean.iter().map(|&m| (m / total) as f32).collect();
+    let scales: Vec<f64> = weights.iter().map(|w| w.sqrt()).collect();
     const BLOCK: usize = 4096;
     let blocks = len.div_ceil(BLOCK);
     let range = |b: usize| b * BLOCK..((b + 1) * BLOCK).min(len);
     let centred = |b: usize| {
         let r = range(b);
         DMatrix::<f64>::from_fn(n, r.len(), |i, c| {
-            f64::from(vectors[i][r.start + c]) - f64::from(mean[r.start + c])
+            scales[i] * (f64::from(vectors[i][r.start + c]) - f64::from(mean[r.start + c]))
         })
     };
     let gram = ordered_block_sum(blocks, n, |b| {
@@ -280,5 +299,27 @@ mod tests {
         assert!(c.rows[10..].iter().all(|&v| v == 0.0), "rank one: the second row is zero");
         assert!((c.mean[0] - (1.0 - 4.0 * (-0.5 / 3.0))).abs() < 1e-5);
         assert!(fit_components(&[], 1).is_err());
+    }
+
+    #[test]
+    fn a_weight_of_two_counts_a_vector_twice() {
+        let vectors: Vec<Vec<f32>> = (0..4)
+            .map(|i| (0..6).map(|c| ((i * 7 + c * 3) % 5) as f32 - (i as f32) * 0.3).collect())
+            .collect();
+        let weighted = fit_weighted_components(&vectors, &[1.0, 2.0, 1.0, 1.0], 3).unwrap();
+        let mut repeated = vectors.clone();
+        repeated.push(vectors[1].clone());
+        let plain = fit_components(&repeated, 3).unwrap();
+        for (a, b) in weighted.mean.iter().zip(&plain.mean) {
+            assert!((a - b).abs() < 1e-5, "mean {a} vs {b}");
+        }
+        // The same directions, up to sign.
+        for j in 0..3 {
+            let (a, b) = (&weighted.rows[j * 6..(j + 1) * 6], &plain.rows[j * 6..(j + 1) * 6]);
+            let dot: f32 = a.iter().zip(b).map(|(x, y)| x * y).sum();
+            assert!((dot.abs() - 1.0).abs() < 1e-4, "direction {j}: |dot| {dot}");
+        }
+        assert!(fit_weighted_components(&vectors, &[1.0, 0.0, 1.0, 1.0], 3).is_err());
+        assert!(fit_weighted_components(&vectors, &[1.0; 3], 3).is_err());
     }
 }

@@ -17,7 +17,7 @@ use deepbrdf_data::Progress;
 use deepbrdf_data::layout::LAYOUT_VALUES;
 
 use super::augmentation::sample_layout;
-use super::basis::{basis_t, fit_components, fit_slice_basis, project};
+use super::basis::{basis_t, fit_slice_basis, fit_weighted_components, project};
 use super::config::SliceConfig;
 use crate::autoencoder::Autoencoder;
 use crate::error::ModelError;
@@ -51,10 +51,26 @@ impl<'a> SliceStep<'a> {
         Ok(Self { config, layers, data, dropout: config.dropout()?, fit: None })
     }
 
-    /// The number of training samples: the BRDFs, their augmentations and the streamed BRDFs.
+    /// The number of examples of an epoch: the held samples (the BRDFs and their
+    /// augmentations) `held_passes` times, then the streamed BRDFs once.
     pub(crate) fn samples(&self) -> usize {
-        self.layers.augmentation.samples(self.data.len())
+        self.held() * self.layers.augmentation.held_passes
             + self.data.streamed().map_or(0, |s| s.len())
+    }
+
+    /// The number of held samples.
+    fn held(&self) -> usize {
+        self.layers.augmentation.samples(self.data.len())
+    }
+
+    /// The sample of example `i` of an epoch (see [`samples`](Self::samples)).
+    fn sample_of(&self, i: usize) -> usize {
+        let held = self.held();
+        let passes = self.layers.augmentation.held_passes;
+        match i < held * passes {
+            true => i % held,
+            false => i - held * (passes - 1),
+        }
     }
 }
 
@@ -93,6 +109,7 @@ impl TrainStep for SliceStep<'_> {
             .ok_or_else(|| ModelError::Invalid("a slice step before its fit".into()))?;
         let augment = self.dropout.as_ref().map(|d| d.at_epoch(epoch));
         let n = self.data.len();
+        let indices: Vec<usize> = indices.iter().map(|&i| self.sample_of(i)).collect();
         let inputs: Vec<f32> = indices
             .iter()
             .flat_map(|&i| {
@@ -103,7 +120,7 @@ impl TrainStep for SliceStep<'_> {
                 }
             })
             .collect();
-        slice_gradients(model, fit, indices, inputs, device)
+        slice_gradients(model, fit, &indices, inputs, device)
     }
 }
 
@@ -230,7 +247,10 @@ fn prepare(
         ));
     }
     progress.status(&format!("fitting {} principal components", layers.components));
-    let components = fit_components(&targets, layers.components)?;
+    let passes = augmentation.held_passes as f64;
+    let counts: Vec<f64> =
+        (0..targets.len()).map(|i| if i < samples { passes } else { 1.0 }).collect();
+    let components = fit_weighted_components(&targets, &counts, layers.components)?;
     let mut model = model;
     if fresh {
         model = model.with_slice_fit(&basis, &components.mean, &components.rows)?;
