@@ -12,7 +12,9 @@
 # Writes WORK/corpus-N/{known,heldout}/results.md and copies them into
 # results/editing-corpus/corpus-N/. NR (default 1000) bounds the regressor's corpus materials.
 # HELD_PASSES=P (default 1) trains with P passes over the measured materials per epoch against
-# one over the corpus (`train --held-passes`), into corpus-N-heldP.
+# one over the corpus (`train --held-passes`), into corpus-N-heldP. REGRESSOR_ONLY=1 gives the
+# corpus to the regressor alone (the autoencoder trains on the measured materials), into
+# corpus-N-regressor: which of the two networks the corpus helps.
 # Every step resumes: run it again after an interruption. Set EXPERIMENTS to a built binary to
 # skip `cargo run`.
 set -euo pipefail
@@ -24,6 +26,8 @@ nr="${NR:-1000}"
 passes="${HELD_PASSES:-1}"
 suffix=""
 (( passes > 1 )) && suffix="-held$passes"
+regressor_only="${REGRESSOR_ONLY:-0}"
+(( regressor_only == 1 )) && suffix="$suffix-regressor"
 cd "$(dirname "$0")/.."
 source scripts/experiments.sh
 mkdir -p "$work"
@@ -47,7 +51,7 @@ for n in "${sizes[@]}"; do
     corpus=()
     regressor_corpus=()
     if (( n > 0 )); then
-        corpus=(--corpus "$work/corpus/corpus.jsonl" --corpus-count "$n")
+        (( regressor_only == 1 )) || corpus=(--corpus "$work/corpus/corpus.jsonl" --corpus-count "$n")
         regressor_corpus=(--corpus "$work/corpus/corpus.jsonl" --corpus-count "$(( nr < n ? nr : n ))")
     fi
     if [[ ! -f "$dir/model/model/model.json" ]]; then

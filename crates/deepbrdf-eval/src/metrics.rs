@@ -150,6 +150,37 @@ impl Default for ImageRelaeConfig {
     }
 }
 
+impl ImageRelaeConfig {
+    /// A figure's renders: the preview sphere under the default sun and sky, `size` pixels
+    /// square, `spp` Owen-scrambled Sobol samples per pixel (less grain than independent ones at
+    /// the same count), seeded.
+    pub fn figure(size: u32, spp: u32, seed: u64) -> Self {
+        Self {
+            scene: SceneConfig::default(),
+            render: RenderSettings { size, spp, seed, jitter: true, sampler: Sampler::Sobol },
+        }
+    }
+
+    /// The same settings with the next seed.
+    pub fn next_seed(&self) -> Self {
+        Self {
+            render: RenderSettings { seed: self.render.seed.wrapping_add(1), ..self.render },
+            ..*self
+        }
+    }
+
+    /// The renderer's noise at these settings: the image RelAE between two renders of `table`,
+    /// with this seed and the next. It bounds the noise of a figure's tiles; a reconstruction
+    /// measured by [`ImageRelae`] shares its original's random numbers and carries less.
+    pub fn noise(&self, table: &MerlTable) -> Result<f64> {
+        let scene = self.scene.build()?;
+        let brdf = MerlBrdf::new(table);
+        let a = render(&scene, &brdf, &self.render, &Silent)?;
+        let b = render(&scene, &brdf, &self.next_seed().render, &Silent)?;
+        relae(&b, &a)
+    }
+}
+
 /// Image-space RelAE of reconstructions of one original table: the original is rendered once;
 /// each reconstruction is rendered with the same seed and the original's sampling, so both
 /// renders draw the same directions and their difference carries (almost) no Monte Carlo noise,
@@ -250,6 +281,16 @@ mod tests {
 mod image_relae_tests {
     use super::*;
     use deepbrdf_data::testing::synthetic_table;
+
+    #[test]
+    fn a_figure_s_noise_falls_with_its_samples() {
+        let table = synthetic_table(1);
+        let noise = |spp| ImageRelaeConfig::figure(32, spp, 3).noise(&table).unwrap();
+        let (coarse, fine) = (noise(1), noise(32));
+        assert!(fine > 0.0 && fine < 0.5 * coarse, "noise {fine} at 32 spp vs {coarse} at 1");
+        let config = ImageRelaeConfig::figure(32, 4, 7);
+        assert_eq!((config.render.sampler, config.next_seed().render.seed), (Sampler::Sobol, 8));
+    }
 
     #[test]
     fn noise_cancels_between_original_and_reconstruction() {

@@ -6,6 +6,7 @@ mod corpus_arg;
 mod data_args;
 mod device_arg;
 mod editing;
+mod figure_arg;
 mod latent_file;
 mod model_arg;
 mod progress;

@@ -49,6 +49,9 @@ pub struct Args {
     /// Epochs of the IPCA regressor when none is saved [default: the library's].
     #[arg(long)]
     pub epochs: Option<usize>,
+    /// The figures' renders.
+    #[command(flatten)]
+    pub figure: crate::figure_arg::FigureArg,
     /// Skip the figures (suite only).
     #[arg(long)]
     pub no_figures: bool,
@@ -169,6 +172,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let started = Instant::now();
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
+    let figure = args.figure.config()?;
     let device = crate::device_arg::device()?;
     let (model_dir, model, deep_regressor) = args.editor.load(&device)?;
     let k = model.k();
@@ -215,11 +219,17 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         let paths =
             interpolate::paths(&model, Some(&ipca), &set.tables[a], &set.tables[b], 9, progress)?;
         let refs: Vec<&Path3> = paths.iter().collect();
-        interpolate::strip(&refs, &|row, i| {
-            format!("{} t={:.3}", paths[row].name, i as f64 / 8.0)
-        })?
-        .write_png(&args.out.join("fig10_interpolation.png"))?;
-        md += "## Fig. 10: red-metallic-paint to red-fabric, 9 steps\n\n![Fig. 10](fig10_interpolation.png)\n\nImage RelAE between consecutive steps (128 px sphere, sun and sky, 16 spp):\n\n";
+        let (sheet, noise) = interpolate::strip(
+            &refs,
+            &|row, i| format!("{} t={:.3}", paths[row].name, i as f64 / 8.0),
+            &figure,
+        )?;
+        sheet.write_png(&args.out.join("fig10_interpolation.png"))?;
+        let _ = write!(
+            md,
+            "## Fig. 10: red-metallic-paint to red-fabric, 9 steps\n\n![Fig. 10](fig10_interpolation.png)\n\n{}\n\nImage RelAE between consecutive steps (128 px sphere, sun and sky, 16 spp):\n\n",
+            interpolate::figure_caption(&figure, noise)
+        );
         md += &interpolate::summary(&paths)?;
 
         // Fig. 12: diffuse colours of gray-plastic.
@@ -245,12 +255,17 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             rows.push(Path3 { name: format!("DeepBRDF {}", mode.name()), tables, images });
         }
         let refs: Vec<&Path3> = rows.iter().collect();
-        interpolate::strip(&refs, &|row, i| match i {
+        let captions = |row: usize, i: usize| match i {
             0 => "original".into(),
             _ => format!("{} {}", rows[row].name.trim_start_matches("DeepBRDF "), colours[i - 1].0),
-        })?
-        .write_png(&args.out.join("fig12_diffuse.png"))?;
-        md += "\n## Fig. 12: diffuse albedo of gray-plastic\n\n![Fig. 12](fig12_diffuse.png)\n\nRows: the paper's edit, the residual edit; first column the measurement. Requested vs re-estimated diffuse albedo:\n\n| edit | requested | paper: achieved | residual: achieved |\n| --- | --- | --- | --- |\n";
+        };
+        let (sheet, noise) = interpolate::strip(&refs, &captions, &figure)?;
+        sheet.write_png(&args.out.join("fig12_diffuse.png"))?;
+        let _ = write!(
+            md,
+            "\n## Fig. 12: diffuse albedo of gray-plastic\n\n![Fig. 12](fig12_diffuse.png)\n\n{}\n\nRows: the paper's edit, the residual edit; first column the measurement. Requested vs re-estimated diffuse albedo:\n\n| edit | requested | paper: achieved | residual: achieved |\n| --- | --- | --- | --- |\n",
+            interpolate::figure_caption(&figure, noise)
+        );
         for (i, (name, c)) in colours.iter().enumerate() {
             let got: Vec<String> = rows
                 .iter()
@@ -318,12 +333,14 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                 }
             }
             let refs: Vec<&Path3> = rows.iter().collect();
-            interpolate::strip(&refs, &|row, i| format!("{} x{:.2}", rows[row].name, usable[i].0))?
-                .write_png(&args.out.join(format!("{fig}.png")))?;
+            let captions = |row: usize, i: usize| format!("{} x{:.2}", rows[row].name, usable[i].0);
+            let (sheet, noise) = interpolate::strip(&refs, &captions, &figure)?;
+            sheet.write_png(&args.out.join(format!("{fig}.png")))?;
             let _ = write!(
                 md,
-                "\n## {}: roughness of {material}\n\n![{fig}]({fig}.png)\n\nRows: {}; columns: roughness x{}.\n",
+                "\n## {}: roughness of {material}\n\n![{fig}]({fig}.png)\n\n{}\n\nRows: {}; columns: roughness x{}.\n",
                 if fig.starts_with("fig13") { "Fig. 13" } else { "Fig. 14" },
+                interpolate::figure_caption(&figure, noise),
                 rows.iter().map(|r| r.name.as_str()).collect::<Vec<_>>().join(", "),
                 usable.iter().map(|(s, _)| format!("{s:.2}")).collect::<Vec<_>>().join(", x")
             );

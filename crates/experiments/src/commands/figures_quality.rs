@@ -25,10 +25,10 @@ use deepbrdf_data::{MerlTable, Progress, Silent};
 use deepbrdf_eval::baseline::{BaselineCodec, BaselineMethod};
 use deepbrdf_eval::figures::{draw_scatter, LatentPlane, ScatterPlot, ScatterPoint};
 use deepbrdf_eval::harness::{Codec, Method as _};
-use deepbrdf_eval::metrics::{relae, ImageRelae, ImageRelaeConfig};
+use deepbrdf_eval::metrics::{relae, ImageRelae};
 use deepbrdf_model::DeepBrdf;
 use deepbrdf_render::sheet::{contact_sheet, SheetConfig, Tile};
-use deepbrdf_render::{render, MerlBrdf, RenderSettings, Sampler, SceneConfig, Tonemap};
+use deepbrdf_render::{render, MerlBrdf, RenderSettings, Tonemap};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -53,15 +53,9 @@ pub struct Args {
     /// a finer sweep, three by default to keep the committed figure small).
     #[arg(long = "k", value_name = "K,...", value_delimiter = ',', default_value = "5,10,40")]
     pub ks: Vec<usize>,
-    /// Fig. 6's tile size in pixels.
-    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(16..=1024))]
-    pub size: u32,
-    /// Fig. 6's samples per pixel.
-    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=4096))]
-    pub spp: u32,
-    /// Seed of the renders (the noise measure's second render uses the next one).
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
+    /// Fig. 6's renders.
+    #[command(flatten)]
+    pub figure: crate::figure_arg::FigureArg,
     /// Fig. 5: at most this many materials shown as a render with their name.
     #[arg(long, default_value_t = 24)]
     pub labels: usize,
@@ -143,14 +137,8 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             seen.join(", ")
         );
     }
-    let settings = RenderSettings {
-        size: args.size,
-        spp: args.spp,
-        seed: args.seed,
-        jitter: true,
-        sampler: Sampler::Sobol,
-    };
-    settings.validate()?;
+    let config = args.figure.config()?;
+    let settings = config.render;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let tonemap = Tonemap::default();
@@ -165,7 +153,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         progress.advance(1);
     }
     progress.finish();
-    let scene = SceneConfig::default().build()?;
+    let scene = config.scene.build()?;
     let thumb_settings = RenderSettings { size: THUMB_SIZE, spp: THUMB_SPP, ..settings };
     progress.start(n as u64, "thumbnails");
     let mut thumbs = Vec::with_capacity(n);
@@ -214,11 +202,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     write_atomic(&args.out.join("fig5.csv"), csv5.as_bytes())?;
 
     // Fig. 6: the measurements and the renderer's noise.
-    let config = ImageRelaeConfig { scene: SceneConfig::default(), render: settings };
-    let other_seed = ImageRelaeConfig {
-        render: RenderSettings { seed: settings.seed.wrapping_add(1), ..settings },
-        ..config
-    };
+    let other_seed = config.next_seed();
     let columns = 2 + 2 * ks.len();
     progress.start((shown.len() * (columns + 1)) as u64, "rendering Fig. 6");
     let sheet = sheet_config(columns as u32);
@@ -343,10 +327,10 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         shown_labels = labelled.len(),
         materials = args.materials.join(", "),
         ks = ks.iter().map(usize::to_string).collect::<Vec<_>>().join(", "),
-        size = args.size,
-        spp = args.spp,
-        seed = args.seed,
-        seed2 = args.seed.wrapping_add(1),
+        size = settings.size,
+        spp = settings.spp,
+        seed = settings.seed,
+        seed2 = other_seed.render.seed,
         scope_cap = capitalise(scope),
     );
     write_atomic(&args.out.join("summary.md"), md.as_bytes())?;

@@ -39,6 +39,9 @@ pub struct Args {
     /// at the model's k on --collection / --data].
     #[arg(long, value_name = "FILE")]
     pub ipca_basis: Option<PathBuf>,
+    /// The strip's renders.
+    #[command(flatten)]
+    pub figure: crate::figure_arg::FigureArg,
     /// Write every path's tables, not only DeepBRDF's (35 MB each).
     #[arg(long)]
     pub all_tables: bool,
@@ -86,23 +89,37 @@ pub fn render_all(reference: &ImageRelae, tables: &[MerlTable]) -> anyhow::Resul
     tables.iter().map(|t| Ok(reference.render(t)?)).collect()
 }
 
-/// The strip: one row per path, captioned.
+/// A strip: one row per path, captioned, each table rendered at the figure's settings with its
+/// own importance sampling (the paths' `images`, at the measures' settings, are not reused), and
+/// the renderer's noise there: the image RelAE between two seeds' renders of the first tile.
 pub fn strip(
     paths: &[&Path3],
     captions: &dyn Fn(usize, usize) -> String,
-) -> anyhow::Result<deepbrdf_render::image::Srgb8Image> {
+    figure: &ImageRelaeConfig,
+) -> anyhow::Result<(deepbrdf_render::image::Srgb8Image, f64)> {
     let tonemap = Tonemap { exposure: 1.0 };
     let mut tiles = Vec::new();
     for (row, p) in paths.iter().enumerate() {
-        for (i, img) in p.images.iter().enumerate() {
-            tiles.push(Tile {
-                image: img.to_srgb8(&tonemap, [24, 24, 24]),
-                caption: captions(row, i),
-            });
+        for (i, table) in p.tables.iter().enumerate() {
+            let image =
+                ImageRelae::new(table, figure)?.reference().to_srgb8(&tonemap, [24, 24, 24]);
+            tiles.push(Tile { image, caption: captions(row, i) });
         }
     }
-    let columns = paths.first().map(|p| p.images.len()).unwrap_or(1) as u32;
-    Ok(contact_sheet(&tiles, &SheetConfig { columns, ..SheetConfig::default() })?)
+    let first = paths.first().and_then(|p| p.tables.first()).context("a strip of no tables")?;
+    let noise = figure.noise(first)?;
+    let columns = paths.first().map(|p| p.tables.len()).unwrap_or(1) as u32;
+    let config = SheetConfig { columns, ..SheetConfig::default() };
+    Ok((contact_sheet(&tiles, &config)?, noise))
+}
+
+/// How a figure's tiles were rendered, and their noise, for its caption.
+pub fn figure_caption(figure: &ImageRelaeConfig, noise: f64) -> String {
+    let r = &figure.render;
+    format!(
+        "{} px tiles, {} Sobol samples per pixel, seed {}; render noise (image RelAE between two seeds' renders of the first tile) {noise:.4}.",
+        r.size, r.spp, r.seed
+    )
 }
 
 /// The three paths from `a` to `b` (`ipca` optional).
@@ -202,15 +219,19 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         }
     }
     let refs: Vec<&Path3> = paths.iter().collect();
-    let sheet = strip(&refs, &|row, i| {
-        format!("{} t={:.2}", paths[row].name, i as f64 / (steps - 1) as f64)
-    })?;
+    let figure = args.figure.config()?;
+    let (sheet, noise) = strip(
+        &refs,
+        &|row, i| format!("{} t={:.2}", paths[row].name, i as f64 / (steps - 1) as f64),
+        &figure,
+    )?;
     let png = args.out.join("strip.png");
     sheet.write_png(&png)?;
     let text = format!(
-        "# {name_a} -> {name_b}, {steps} steps (model {}, k = {})\n\nWritten by `experiments interpolate`; image RelAE between consecutive renders (128 px sphere, sun and sky, 16 spp, the first material's sampling).\n\n{}",
+        "# {name_a} -> {name_b}, {steps} steps (model {}, k = {})\n\nWritten by `experiments interpolate`; image RelAE between consecutive renders (128 px sphere, sun and sky, 16 spp, the first material's sampling). The strip: {}\n\n{}",
         model.id(),
         model.k(),
+        figure_caption(&figure, noise),
         summary(&paths)?
     );
     deepbrdf_data::files::write_atomic(&args.out.join("summary.md"), text.as_bytes())?;
