@@ -79,3 +79,22 @@ impl ModelArg {
         }
     }
 }
+
+/// `path` as written in a results file: under the shipped model's folder, relative to the
+/// repository (`models/default/...`) instead of this machine's absolute path; others as given.
+pub fn shown(path: &Path) -> String {
+    match path.strip_prefix(DEFAULT_MODEL_DIR) {
+        Ok(rest) => Path::new("models/default").join(rest).display().to_string(),
+        Err(_) => path.display().to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_shipped_folder_is_shown_relative_to_the_repository() {
+        let regressor = std::path::Path::new(super::DEFAULT_MODEL_DIR).join("regressor");
+        assert_eq!(super::shown(&regressor), "models/default/regressor");
+        assert_eq!(super::shown(std::path::Path::new("runs/m")), "runs/m");
+    }
+}

@@ -209,7 +209,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         model.id(),
         set.len(),
         set.label,
-        reg_dir.display()
+        crate::model_arg::shown(&reg_dir)
     );
 
     let mut sweeps_md = String::new();
