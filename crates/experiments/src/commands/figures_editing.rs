@@ -20,6 +20,7 @@
 //!   re-estimated roughness along each Fig. 13/14 sweep.
 //!
 //! Writes `results.md` (the tables), `suite.csv` (every material and edit) and the figures.
+use super::editing_suite::{lobe_columns, lobe_summary, SuiteRow, SUITE_METHODS};
 use super::interpolate::{self, Path3};
 use crate::data_args::DataArgs;
 use crate::editing::{self, EditMode, EditorArg, ModelCodec, Space};
@@ -27,8 +28,8 @@ use anyhow::Context;
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::attributes::{Attributes, FitConfig};
 use deepbrdf_eval::editing::{
-    analytic_edit, edit_outcome, is_monotone, judge_edit, plausibility, ColourEdit, Edit, EditLobe,
-    EditOutcome, Lobe, LobeBar, LobeTally, ScalarEdit,
+    analytic_edit, edit_outcome, is_monotone, judge_edit, plausibility, ColourEdit, Edit,
+    EditOutcome, Lobe, ScalarEdit,
 };
 use deepbrdf_eval::metrics::{ImageRelae, ImageRelaeConfig};
 use deepbrdf_eval::stats::{finite_mean, finite_median};
@@ -77,78 +78,6 @@ fn suite_edits(a: &Attributes) -> Vec<(&'static str, Edit)> {
 
 /// The roughness scales of the Fig. 13/14 sweeps.
 const SWEEP: [f64; 7] = [0.25, 0.397, 0.63, 1.0, 1.587, 2.52, 4.0];
-
-/// One row of the suite.
-struct SuiteRow {
-    material: String,
-    method: &'static str,
-    /// The edit's mode ("paper", "residual"; "-" for the analytic edit).
-    mode: &'static str,
-    edit: &'static str,
-    outcome: EditOutcome,
-    identity_relae: f64,
-    plausible: bool,
-    max_albedo: f64,
-    /// The lobe measures; `None` where the original's or the decoded table's lobe is undefined
-    /// (no valid cell where it is read).
-    lobe: Option<EditLobe>,
-}
-
-/// The suite's CSV columns of the lobe measures: floor, peak and HWHM ratios, dark hole, the
-/// edit's bar, whether it meets it, whether it passes (meets its bar, if any, without a dark
-/// hole); empty where the lobe was not measured.
-fn lobe_columns(lobe: Option<&EditLobe>) -> String {
-    let yes = |b: bool| if b { "yes" } else { "no" };
-    let Some(l) = lobe else { return ",,,,,,".into() };
-    let (c, v) = (l.comparison, l.verdict);
-    format!(
-        "{:.6},{:.6},{:.6},{},{},{},{}",
-        c.floor_ratio,
-        c.peak_ratio,
-        c.hwhm_ratio,
-        yes(c.dark_hole),
-        v.bar.map_or("none", LobeBar::key),
-        v.meets_bar.map_or("-", yes),
-        yes(v.passes())
-    )
-}
-
-/// The summary's lobe table: per representation and mode, each bar's count (met / held, and
-/// passed: met without a dark hole), the dark holes and the edits not measured.
-fn lobe_summary(rows: &[SuiteRow]) -> String {
-    let mut md = String::from("| representation | mode |");
-    for bar in LobeBar::ALL {
-        let _ = write!(md, " {}: met / held (passed) |", bar.name());
-    }
-    md += " dark holes | not measured |\n| --- | --- | ---: | ---: | ---: | ---: | ---: |\n";
-    for (method, mode) in SUITE_METHODS {
-        let sel: Vec<&SuiteRow> =
-            rows.iter().filter(|r| r.method == method && r.mode == mode).collect();
-        if sel.is_empty() {
-            continue;
-        }
-        let t = LobeTally::of(sel.iter().filter_map(|r| r.lobe.as_ref().map(|l| &l.verdict)));
-        let _ = write!(md, "| {method} | {mode} |");
-        for c in t.bars {
-            let _ = write!(md, " {}/{} ({}) |", c.met, c.held, c.passed);
-        }
-        let _ = writeln!(md, " {}/{} | {} |", t.dark_holes, t.edits, sel.len() - t.edits);
-    }
-    md
-}
-
-/// The suite's (representation, mode) pairs, in the order of its tables: each representation's
-/// paper and residual edits and the residual edit carried onto the table (`Space::transfer`),
-/// and the analytic edit without a network.
-const SUITE_METHODS: [(&str, &str); 7] = [
-    ("DeepBRDF", "paper"),
-    ("DeepBRDF", "residual"),
-    ("DeepBRDF", "transfer"),
-    ("IPCA", "paper"),
-    ("IPCA", "residual"),
-    ("IPCA", "transfer"),
-    ("analytic", "-"),
-];
 
 /// A representation with its regressor, and the latent of each material under it.
 struct Rep<'a> {
