@@ -168,17 +168,6 @@ impl ImageRelaeConfig {
             ..*self
         }
     }
-
-    /// The renderer's noise at these settings: the image RelAE between two renders of `table`,
-    /// with this seed and the next. It bounds the noise of a figure's tiles; a reconstruction
-    /// measured by [`ImageRelae`] shares its original's random numbers and carries less.
-    pub fn noise(&self, table: &MerlTable) -> Result<f64> {
-        let scene = self.scene.build()?;
-        let brdf = MerlBrdf::new(table);
-        let a = render(&scene, &brdf, &self.render, &Silent)?;
-        let b = render(&scene, &brdf, &self.next_seed().render, &Silent)?;
-        relae(&b, &a)
-    }
 }
 
 /// Image-space RelAE of reconstructions of one original table: the original is rendered once;
@@ -210,6 +199,16 @@ impl ImageRelae {
     pub fn render(&self, reconstruction: &MerlTable) -> Result<Image> {
         let brdf = MerlBrdf::new_sampled(reconstruction, self.sampling.clone());
         Ok(render(&self.scene, &brdf, &self.config.render, &Silent)?)
+    }
+
+    /// The renderer's noise at these settings: the image RelAE between the original's render
+    /// and one with the next seed; `original` is the table this measure was made with. It bounds
+    /// the noise of a figure's tiles; a reconstruction measured here shares the original's
+    /// random numbers and carries less.
+    pub fn noise(&self, original: &MerlTable) -> Result<f64> {
+        let brdf = MerlBrdf::new_sampled(original, self.sampling.clone());
+        let other = render(&self.scene, &brdf, &self.config.next_seed().render, &Silent)?;
+        relae(&other, &self.reference)
     }
 
     /// RelAE of `reconstruction`'s render against the original's.
@@ -285,7 +284,10 @@ mod image_relae_tests {
     #[test]
     fn a_figure_s_noise_falls_with_its_samples() {
         let table = synthetic_table(1);
-        let noise = |spp| ImageRelaeConfig::figure(32, spp, 3).noise(&table).unwrap();
+        let noise = |spp| {
+            let config = ImageRelaeConfig::figure(32, spp, 3);
+            ImageRelae::new(&table, &config).unwrap().noise(&table).unwrap()
+        };
         let (coarse, fine) = (noise(1), noise(32));
         assert!(fine > 0.0 && fine < 0.5 * coarse, "noise {fine} at 32 spp vs {coarse} at 1");
         let config = ImageRelaeConfig::figure(32, 4, 7);

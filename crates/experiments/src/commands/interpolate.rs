@@ -99,15 +99,18 @@ pub fn strip(
 ) -> anyhow::Result<(deepbrdf_render::image::Srgb8Image, f64)> {
     let tonemap = Tonemap { exposure: 1.0 };
     let mut tiles = Vec::new();
+    let mut noise = None;
     for (row, p) in paths.iter().enumerate() {
         for (i, table) in p.tables.iter().enumerate() {
-            let image =
-                ImageRelae::new(table, figure)?.reference().to_srgb8(&tonemap, [24, 24, 24]);
+            let tile = ImageRelae::new(table, figure)?;
+            if noise.is_none() {
+                noise = Some(tile.noise(table)?);
+            }
+            let image = tile.reference().to_srgb8(&tonemap, [24, 24, 24]);
             tiles.push(Tile { image, caption: captions(row, i) });
         }
     }
-    let first = paths.first().and_then(|p| p.tables.first()).context("a strip of no tables")?;
-    let noise = figure.noise(first)?;
+    let noise = noise.context("a strip of no tables")?;
     let columns = paths.first().map(|p| p.tables.len()).unwrap_or(1) as u32;
     let config = SheetConfig { columns, ..SheetConfig::default() };
     Ok((contact_sheet(&tiles, &config)?, noise))
