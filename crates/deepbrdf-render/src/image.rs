@@ -261,6 +261,9 @@ fn encode_srgb8(linear: f32) -> u8 {
     (linear_to_srgb(linear.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8
 }
 
+/// JPEG quality of the figures written by [`Srgb8Image::write_figure`].
+pub const FIGURE_JPEG_QUALITY: u8 = 95;
+
 /// An 8-bit sRGB image, row-major RGB bytes.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Srgb8Image {
@@ -309,6 +312,29 @@ impl Srgb8Image {
     pub fn write_png(&self, path: &Path) -> Result<()> {
         let png = self.png_bytes().map_err(|e| RenderError::format(path, e.to_string()))?;
         Ok(deepbrdf_data::files::write_atomic(path, &png)?)
+    }
+
+    /// Writes a figure atomically: JPEG at quality [`FIGURE_JPEG_QUALITY`] for a `.jpg` or
+    /// `.jpeg` path (a committed figure of renders: a quarter of the PNG's size with no change a
+    /// reader sees), PNG otherwise.
+    pub fn write_figure(&self, path: &Path) -> Result<()> {
+        let jpeg = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("jpg") || e.eq_ignore_ascii_case("jpeg"));
+        if !jpeg {
+            return self.write_png(path);
+        }
+        use image::codecs::jpeg::JpegEncoder;
+        use image::ImageEncoder;
+        if self.data.len() != 3 * self.width as usize * self.height as usize {
+            return Err(RenderError::Invalid("image buffer has the wrong size".into()));
+        }
+        let mut bytes = Vec::new();
+        JpegEncoder::new_with_quality(&mut bytes, FIGURE_JPEG_QUALITY)
+            .write_image(&self.data, self.width, self.height, image::ExtendedColorType::Rgb8)
+            .map_err(|e| RenderError::format(path, format!("cannot encode JPEG: {e}")))?;
+        Ok(deepbrdf_data::files::write_atomic(path, &bytes)?)
     }
 
     /// The PNG encoding of the image, at the encoder's best compression with adaptive filters
@@ -423,6 +449,26 @@ mod tests {
         assert_eq!(back.get_pixel(1, 0).0, [188, 255, 0]);
         // No temp files left behind.
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+    }
+
+    #[test]
+    fn a_figure_is_written_as_its_extension_says() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut img = Srgb8Image::filled(16, 8, [200, 120, 40]);
+        img.data[0..3].copy_from_slice(&[0, 0, 0]);
+        for (name, format) in
+            [("f.jpg", image::ImageFormat::Jpeg), ("f.png", image::ImageFormat::Png)]
+        {
+            let path = dir.path().join(name);
+            img.write_figure(&path).unwrap();
+            let bytes = std::fs::read(&path).unwrap();
+            assert_eq!(image::guess_format(&bytes).unwrap(), format, "{name}");
+            let back = image::load_from_memory(&bytes).unwrap().to_rgb8();
+            assert_eq!((back.width(), back.height()), (16, 8));
+            // Quality 95: a flat colour comes back within a few levels.
+            let p = back.get_pixel(8, 4).0;
+            assert!(p.iter().zip([200u8, 120, 40]).all(|(a, b)| a.abs_diff(b) <= 3), "{p:?}");
+        }
     }
 
     #[test]

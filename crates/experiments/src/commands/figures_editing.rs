@@ -1,5 +1,5 @@
 //! `experiments figures-editing [--model DIR] [--out results/editing] [--every N]`: the
-//! editing figures of §5.1 as PNG strips and the measured edit suite
+//! editing figures of §5.1 as JPEG strips and the measured edit suite
 //! (`deepbrdf_eval::editing::measures`), in-sample (the
 //! model and the regressors saw every material).
 //!
@@ -153,10 +153,10 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             &|row, i| format!("{} t={:.3}", paths[row].name, i as f64 / 8.0),
             &figure,
         )?;
-        sheet.write_png(&args.out.join("fig10_interpolation.png"))?;
+        sheet.write_figure(&args.out.join("fig10_interpolation.jpg"))?;
         let _ = write!(
             md,
-            "## Fig. 10: red-metallic-paint to red-fabric, 9 steps\n\n![Fig. 10](fig10_interpolation.png)\n\n{}\n\nImage RelAE between consecutive steps (128 px sphere, sun and sky, 16 spp):\n\n",
+            "## Fig. 10: red-metallic-paint to red-fabric, 9 steps\n\n![Fig. 10](fig10_interpolation.jpg)\n\n{}\n\nImage RelAE between consecutive steps (128 px sphere, sun and sky, 16 spp):\n\n",
             interpolate::figure_caption(&figure, noise)
         );
         md += &interpolate::summary(&paths)?;
@@ -189,10 +189,10 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             _ => format!("{} {}", rows[row].name.trim_start_matches("DeepBRDF "), colours[i - 1].0),
         };
         let (sheet, noise) = interpolate::strip(&refs, &captions, &figure)?;
-        sheet.write_png(&args.out.join("fig12_diffuse.png"))?;
+        sheet.write_figure(&args.out.join("fig12_diffuse.jpg"))?;
         let _ = write!(
             md,
-            "\n## Fig. 12: diffuse albedo of gray-plastic\n\n![Fig. 12](fig12_diffuse.png)\n\n{}\n\nRows: the paper's edit, the residual edit; first column the measurement. Requested vs re-estimated diffuse albedo:\n\n| edit | requested | paper: achieved | residual: achieved |\n| --- | --- | --- | --- |\n",
+            "\n## Fig. 12: diffuse albedo of gray-plastic\n\n![Fig. 12](fig12_diffuse.jpg)\n\n{}\n\nRows: the paper's edit, the residual edit; first column the measurement. Requested vs re-estimated diffuse albedo:\n\n| edit | requested | paper: achieved | residual: achieved |\n| --- | --- | --- | --- |\n",
             interpolate::figure_caption(&figure, noise)
         );
         for (i, (name, c)) in colours.iter().enumerate() {
@@ -264,10 +264,10 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             let refs: Vec<&Path3> = rows.iter().collect();
             let captions = |row: usize, i: usize| format!("{} x{:.2}", rows[row].name, usable[i].0);
             let (sheet, noise) = interpolate::strip(&refs, &captions, &figure)?;
-            sheet.write_png(&args.out.join(format!("{fig}.png")))?;
+            sheet.write_figure(&args.out.join(format!("{fig}.jpg")))?;
             let _ = write!(
                 md,
-                "\n## {}: roughness of {material}\n\n![{fig}]({fig}.png)\n\n{}\n\nRows: {}; columns: roughness x{}.\n",
+                "\n## {}: roughness of {material}\n\n![{fig}]({fig}.jpg)\n\n{}\n\nRows: {}; columns: roughness x{}.\n",
                 if fig.starts_with("fig13") { "Fig. 13" } else { "Fig. 14" },
                 interpolate::figure_caption(&figure, noise),
                 rows.iter().map(|r| r.name.as_str()).collect::<Vec<_>>().join(", "),

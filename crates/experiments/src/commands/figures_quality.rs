@@ -250,7 +250,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         tiles.push(original);
         tiles.extend(cols.iter().map(|c| c.tiles[s].clone()));
     }
-    contact_sheet(&tiles, &sheet)?.write_png(&args.out.join("fig6.png"))?;
+    contact_sheet(&tiles, &sheet)?.write_figure(&args.out.join("fig6.jpg"))?;
 
     let mut csv6 = String::from("material,render_noise");
     for c in &cols {
@@ -308,7 +308,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
          {THUMB_SPP} spp) with their name. The paper's Fig. 5 is a diagram of the same idea: the \
          autoencoder maps the measured BRDFs onto a low-dimensional manifold. In-sample: the \
          model's training data is {data}. Coordinates and latents: `fig5.csv`.\n\n\
-         ## Fig. 6: reconstruction quality\n\n![Fig. 6](fig6.png)\n\n\
+         ## Fig. 6: reconstruction quality\n\n![Fig. 6](fig6.jpg)\n\n\
          Rows: {materials}; columns: the measurement, DeepBRDF at k = {k}, PCA (log of the \
          reflectance) and IPCA (Nielsen et al.'s log-relative mapping) at k = {ks}. Under each \
          reconstruction its image RelAE against the measurement's render (the preview sphere \
@@ -333,7 +333,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     );
     write_atomic(&args.out.join("summary.md"), md.as_bytes())?;
     print!("{md}");
-    eprintln!("wrote {}/fig5.png, fig5.csv, fig6.png, fig6.csv, summary.md", args.out.display());
+    eprintln!("wrote {}/fig5.png, fig5.csv, fig6.jpg, fig6.csv, summary.md", args.out.display());
     Ok(())
 }
 
