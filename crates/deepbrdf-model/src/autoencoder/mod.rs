@@ -54,7 +54,7 @@ impl AutoencoderConfig {
     /// Seeding and drawing happen under one process-wide lock ([`crate::seeded`]): Burn's
     /// generator is shared by the whole process.
     pub fn init_seeded(&self, seed: u64, device: &Device) -> crate::error::Result<Autoencoder> {
-        crate::seeded::with_seed(seed, device, || self.build(device))
+        crate::seeded::try_with_seed(seed, device, || self.build(device))
     }
 
     /// Builds the network on `device` with freshly initialised weights (and a zero offset),

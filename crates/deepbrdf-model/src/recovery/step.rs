@@ -126,7 +126,7 @@ impl TrainStep for RecoveryStep<'_> {
     type Model = RecoveryNet;
 
     fn init(&mut self, device: &Device) -> Result<RecoveryNet> {
-        crate::seeded::with_seed(self.seed, device, || self.config.init(device))
+        crate::seeded::try_with_seed(self.seed, device, || self.config.init(device))
     }
 
     fn skeleton(&mut self, device: &Device) -> Result<RecoveryNet> {
