@@ -269,7 +269,8 @@ impl Model {
     /// g, b)`, `roughness=alpha`) or scaled (`*_scale=x`), through the model's regressor (eq. 7)
     /// and decoder, as `experiments edit` does with the same options. `mode`: `residual`
     /// (default, `Y' = Y + Phi(alpha') - Phi(alpha)`), `paper` (`Y' = Phi(alpha')`), `transfer`
-    /// (the residual edit's change carried onto the table) or `analytic` (no network).
+    /// (the residual edit's change carried onto the table), `analytic` or `stretch` (no network:
+    /// the fitted lobe swapped, or the table's own highlight stretched to the new roughness).
     #[pyo3(signature = (table, *, diffuse=None, diffuse_scale=None, specular=None,
         specular_scale=None, roughness=None, roughness_scale=None, mode=None))]
     #[allow(clippy::too_many_arguments)]

@@ -68,6 +68,8 @@ def test_edit_changes_the_attribute_asked_for(model, chrome):
     # Re-estimated on the edited table, the roughness has grown (how much the other attributes
     # move with it is the editing suite's measure, docs/editing.md).
     assert after[6] > 1.5 * before[6], (before, after)
+    stretched = deepbrdf.attributes(model.edit(plastic, roughness_scale=2.0, mode="stretch"))
+    assert stretched[6] > 1.5 * before[6], (before, stretched)
     with pytest.raises(ValueError, match="not both"):
         model.edit(chrome, roughness=0.1, roughness_scale=2)
     with pytest.raises(ValueError, match="edit mode"):

@@ -1,6 +1,6 @@
 //! `train --corpus [--held-passes N]`, `train-regressor --corpus` and `edit-known` end to end with a tiny model on
 //! three synthetic materials and a few corpus materials: the corpus materials join the training
-//! set, and every known-answer edit is scored for each of the seven methods, the analytic edit
+//! set, and every known-answer edit is scored for each of the eight methods, the analytic edit
 //! ending nearer the answer than the unedited material.
 use crate::util::{self, s};
 
@@ -65,13 +65,14 @@ fn corpus_training_and_known_answer_edits() {
         "--out",
         &s(&out),
         "--methods",
-        "analytic,deepbrdf-residual,deepbrdf-paper,ipca-residual,deepbrdf-transfer,deepbrdf-transfer-paper,ipca-transfer",
+        "analytic,stretch,deepbrdf-residual,deepbrdf-paper,ipca-residual,deepbrdf-transfer,deepbrdf-transfer-paper,ipca-transfer",
     ]);
     assert!(printed.contains("| analytic | **all** |"), "{printed}");
     let csv = std::fs::read_to_string(out.join("known.csv")).unwrap();
     let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
     let methods = [
         "analytic",
+        "stretch",
         "DeepBRDF residual",
         "DeepBRDF paper",
         "IPCA residual",

@@ -6,8 +6,8 @@
 //! specular lobe read off the table as a person sees it, its floor, peak, width and colour, a
 //! dark hole at its centre, and the bars an edit is held to); edits through a representation
 //! and its regressor ([`space`]: eq. (7)'s regressor is `deepbrdf_model::regressor`), the
-//! analytic edit without any network ([`analytic`]), and edits scored against a known answer
-//! ([`known`]).
+//! analytic edit without any network ([`analytic`]) and the stretch edit, which reshapes the
+//! table's own highlight ([`stretch`]), and edits scored against a known answer ([`known`]).
 //!
 //! [`Attributes`]: crate::attributes::Attributes
 
@@ -17,6 +17,7 @@ pub mod lobe;
 pub mod measures;
 pub mod request;
 pub mod space;
+pub mod stretch;
 
 pub use analytic::{analytic_edit, carry_edit};
 pub use known::{KnownEdit, KnownTally};
@@ -33,3 +34,4 @@ pub use space::{
     blend, blend_tables, edit_material, path_weights, EditMode, Edited, ModelCodec, Space,
     DEFAULT_MODE,
 };
+pub use stretch::{stretch_edit, stretch_roughness};

@@ -5,7 +5,7 @@
 //! path, two tables).
 
 use crate::attributes::Attributes;
-use crate::editing::{analytic_edit, carry_edit, Edit};
+use crate::editing::{analytic_edit, carry_edit, stretch_edit, Edit};
 use crate::error::{EvalError, Result};
 use crate::harness::Codec;
 use deepbrdf_data::merl::INVALID_VALUE;
@@ -27,12 +27,20 @@ pub enum EditMode {
     Transfer,
     /// The analytic edit, no network ([`crate::editing::analytic_edit`]).
     Analytic,
+    /// The stretch edit, no network: the roughness by reshaping the table's own highlight,
+    /// the albedos as the analytic edit ([`crate::editing::stretch_edit`]).
+    Stretch,
 }
 
 impl EditMode {
     /// Every mode.
-    pub const ALL: [EditMode; 4] =
-        [EditMode::Paper, EditMode::Residual, EditMode::Transfer, EditMode::Analytic];
+    pub const ALL: [EditMode; 5] = [
+        EditMode::Paper,
+        EditMode::Residual,
+        EditMode::Transfer,
+        EditMode::Analytic,
+        EditMode::Stretch,
+    ];
     /// The modes whose result is a latent, decoded as it is (the browser editor's).
     pub const LATENT: [EditMode; 2] = [EditMode::Paper, EditMode::Residual];
 
@@ -43,6 +51,7 @@ impl EditMode {
             Self::Residual => "residual",
             Self::Transfer => "transfer",
             Self::Analytic => "analytic",
+            Self::Stretch => "stretch",
         }
     }
 
@@ -53,7 +62,24 @@ impl EditMode {
 
     /// Whether the edit goes through a representation and its regressor.
     pub fn needs_network(self) -> bool {
-        self != Self::Analytic
+        !matches!(self, Self::Analytic | Self::Stretch)
+    }
+
+    /// The edit of a mode without a network: `table`, fitted to `original`, edited to
+    /// `requested`; an error for the modes through a representation.
+    pub fn edit_without_network(
+        self,
+        table: &MerlTable,
+        original: &Attributes,
+        requested: &Attributes,
+    ) -> Result<MerlTable> {
+        match self {
+            Self::Analytic => analytic_edit(table, original, requested),
+            Self::Stretch => stretch_edit(table, original, requested),
+            Self::Paper | Self::Residual | Self::Transfer => {
+                Err(EvalError::Invalid(format!("the {self} edit needs a model and its regressor")))
+            }
+        }
     }
 }
 
@@ -137,7 +163,9 @@ impl Space<'_> {
                 self.codec.decode(&self.edited_latent(latent, original, &requested, mode)?)?
             }
             EditMode::Transfer => return self.transfer(table, latent, original, edit, mode),
-            EditMode::Analytic => analytic_edit(table, original, &requested)?,
+            EditMode::Analytic | EditMode::Stretch => {
+                mode.edit_without_network(table, original, &requested)?
+            }
         };
         Ok(Edited { requested, table })
     }
@@ -182,8 +210,8 @@ impl Space<'_> {
         let target = self.latent_of(requested)?;
         Ok(match mode {
             EditMode::Paper => target,
-            EditMode::Analytic => {
-                return Err(EvalError::Invalid("the analytic edit has no latent".into()));
+            EditMode::Analytic | EditMode::Stretch => {
+                return Err(EvalError::Invalid(format!("the {mode} edit has no latent")));
             }
             EditMode::Residual | EditMode::Transfer => {
                 let base = self.latent_of(original)?;
@@ -207,7 +235,7 @@ pub fn edit_material(
     match (mode.needs_network(), editor) {
         (false, _) => {
             let requested = edit.apply(original)?;
-            let table = analytic_edit(table, original, &requested)?;
+            let table = mode.edit_without_network(table, original, &requested)?;
             Ok(Edited { requested, table })
         }
         (true, Some((model, regressor))) => {

@@ -1,8 +1,8 @@
 //! `experiments edit [--model DIR] MATERIAL [--diffuse R,G,B | --diffuse-scale X] [--specular
 //! R,G,B | --specular-scale X] [--roughness X | --roughness-scale X]
-//! [--mode paper|residual|transfer|analytic] -o edited.binary [--render edited.png]`: edits a
+//! [--mode paper|residual|transfer|analytic|stretch] -o edited.binary [--render edited.png]`: edits a
 //! material's diffuse albedo, specular albedo or roughness (§5.1) through the model's regressor
-//! (eq. 7) and decoder (eq. 3), or analytically without a network, writes the edited MERL
+//! (eq. 7) and decoder (eq. 3), or without a network (analytic, stretch), writes the edited MERL
 //! table, and prints the attributes asked for and those re-estimated on the result.
 use crate::data_args::CacheArg;
 use crate::editing::{self, EditMode, EditorArg, DEFAULT_MODE};
@@ -28,7 +28,9 @@ pub struct Args {
     pub edit: EditArgs,
     /// paper: Y' = Phi(alpha'); residual: Y' = Y + Phi(alpha') - Phi(alpha); transfer: the
     /// residual edit's change carried onto the table itself; analytic: the table's fitted
-    /// Lambertian + GGX model swapped for the edited one, no network [default: residual].
+    /// Lambertian + GGX model swapped for the edited one, no network; stretch: the table's own
+    /// highlight stretched to the new roughness and the albedos edited as analytic, no network
+    /// [default: residual].
     #[arg(long, value_parser = editing::mode_parser(&EditMode::ALL))]
     pub mode: Option<EditMode>,
     /// Output MERL .binary file.

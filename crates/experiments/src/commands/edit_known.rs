@@ -58,6 +58,8 @@ pub struct Args {
 pub enum Method {
     /// The analytic edit, no network (`deepbrdf_eval::editing::analytic`).
     Analytic,
+    /// The stretch edit, no network (`deepbrdf_eval::editing::stretch`).
+    Stretch,
     /// DeepBRDF's residual edit.
     DeepbrdfResidual,
     /// DeepBRDF's edit of the paper.
@@ -82,6 +84,7 @@ impl Method {
     fn mode(self) -> EditMode {
         match self {
             Self::Analytic => EditMode::Analytic,
+            Self::Stretch => EditMode::Stretch,
             Self::DeepbrdfResidual | Self::IpcaResidual => EditMode::Residual,
             Self::DeepbrdfPaper | Self::DeepbrdfTransferPaper => EditMode::Paper,
             Self::DeepbrdfTransfer | Self::IpcaTransfer => EditMode::Transfer,
@@ -92,6 +95,7 @@ impl Method {
     fn label(self) -> &'static str {
         match self {
             Self::Analytic => "analytic",
+            Self::Stretch => "stretch",
             Self::DeepbrdfResidual => "DeepBRDF residual",
             Self::DeepbrdfPaper => "DeepBRDF paper",
             Self::IpcaResidual => "IPCA residual",

@@ -65,8 +65,8 @@ pub fn lobe_summary(rows: &[SuiteRow]) -> String {
 
 /// The suite's (representation, mode) pairs, in the order of its tables: each representation's
 /// paper and residual edits and the residual edit carried onto the table (`Space::transfer`),
-/// and the analytic edit without a network.
-pub const SUITE_METHODS: [(&str, &str); 7] = [
+/// and the two edits without a network, analytic and stretch.
+pub const SUITE_METHODS: [(&str, &str); 8] = [
     ("DeepBRDF", "paper"),
     ("DeepBRDF", "residual"),
     ("DeepBRDF", "transfer"),
@@ -74,4 +74,5 @@ pub const SUITE_METHODS: [(&str, &str); 7] = [
     ("IPCA", "residual"),
     ("IPCA", "transfer"),
     ("analytic", "-"),
+    ("stretch", "-"),
 ];

@@ -11,7 +11,9 @@
 //! - The suite, on every N-th material: diffuse albedo x0.5 and a hue change (its channels
 //!   rotated), specular albedo x0.5, roughness x0.5 and x2, and the identity edit, for DeepBRDF
 //!   and IPCA (at the model's k), paper and residual edits and the residual edit carried onto
-//!   the table (transfer), and the analytic edit without a network (`deepbrdf_eval::editing::analytic`): the attributes re-estimated on each
+//!   the table (transfer), and the two edits without a network, analytic
+//!   (`deepbrdf_eval::editing::analytic`) and stretch (`deepbrdf_eval::editing::stretch`): the
+//!   attributes re-estimated on each
 //!   decoded table against the requested ones (target error, change ratio, drift of the
 //!   untouched attributes), the identity edit's image RelAE against the original, the
 //!   plausibility of every decoded table; the specular lobe read off each decoded table against
@@ -28,8 +30,8 @@ use anyhow::Context;
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::attributes::{Attributes, FitConfig};
 use deepbrdf_eval::editing::{
-    analytic_edit, edit_outcome, is_monotone, judge_edit, plausibility, ColourEdit, Edit,
-    EditOutcome, Lobe, ScalarEdit,
+    edit_outcome, is_monotone, judge_edit, plausibility, ColourEdit, Edit, EditOutcome, Lobe,
+    ScalarEdit,
 };
 use deepbrdf_eval::metrics::{ImageRelae, ImageRelaeConfig};
 use deepbrdf_eval::stats::{finite_mean, finite_median};
@@ -347,8 +349,10 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         }
         for (edit_name, edit) in suite_edits(original) {
             let Ok(requested) = edit.apply(original) else { continue };
-            let edited = analytic_edit(table, original, &requested)?;
-            push("analytic", "-", edit_name, &edit, &requested, &edited)?;
+            for mode in [EditMode::Analytic, EditMode::Stretch] {
+                let edited = mode.edit_without_network(table, original, &requested)?;
+                push(mode.name(), "-", edit_name, &edit, &requested, &edited)?;
+            }
         }
         progress.advance(1);
     }
@@ -382,7 +386,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         args.every,
         set.len()
     );
-    for method in ["DeepBRDF", "IPCA", "analytic"] {
+    for method in ["DeepBRDF", "IPCA", "analytic", "stretch"] {
         for (edit_name, _) in suite_edits(&attrs[0]) {
             for (_, mode) in SUITE_METHODS.into_iter().filter(|(m, _)| *m == method) {
                 let sel: Vec<&SuiteRow> = rows
