@@ -8,6 +8,7 @@
 //! order, before the lock is released; otherwise its draws would happen at its first forward
 //! pass, where another thread's seeding can fall in between.
 
+use std::convert::Infallible;
 use std::sync::Mutex;
 
 use burn::module::{ModuleVisitor, Param};
@@ -27,11 +28,10 @@ impl ModuleVisitor for Materialise {
 /// Builds a module with `build` right after seeding `device`'s generator with `seed`, and draws
 /// all its weights, with no other seeded draw in between.
 pub fn with_seed<M: Module>(seed: u64, device: &Device, build: impl FnOnce() -> M) -> M {
-    let _guard = GENERATOR.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-    device.seed(seed);
-    let module = build();
-    module.visit(&mut Materialise);
-    module
+    match try_with_seed(seed, device, || Ok::<M, Infallible>(build())) {
+        Ok(module) => module,
+        Err(never) => match never {},
+    }
 }
 
 /// [`with_seed`] for a build that can fail.

@@ -26,10 +26,8 @@ use crate::editing::analytic_edit;
 use crate::error::{EvalError, Result};
 use deepbrdf_data::ggx::smith_g1;
 use deepbrdf_data::merl::coords::continuous_theta_h;
-use deepbrdf_data::merl::grid::{phi_d_of, theta_d_of, theta_h_of};
-use deepbrdf_data::merl::{
-    cell_index, MerlTable, CELLS, INVALID_VALUE, N_PHI_D, N_THETA_D, N_THETA_H,
-};
+use deepbrdf_data::merl::grid::{phi_d_of, theta_d_of, theta_h_of, ROW};
+use deepbrdf_data::merl::{cell_index, MerlTable, CELLS, INVALID_VALUE, N_PHI_D, N_THETA_H};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -41,8 +39,8 @@ pub fn stretch_edit(
     fitted: &Attributes,
     requested: &Attributes,
 ) -> Result<MerlTable> {
-    if fitted == requested {
-        return Ok(table.clone());
+    if requested.roughness == fitted.roughness {
+        return analytic_edit(table, fitted, requested);
     }
     let stretched = stretch_roughness(table, fitted, requested.roughness)?;
     let between = Attributes { roughness: requested.roughness, ..*fitted };
@@ -69,39 +67,33 @@ pub fn stretch_roughness(
     let floor = fitted.diffuse.map(|d| (d / PI) as f32);
     let values = table.values();
     let mut out = vec![INVALID_VALUE; values.len()];
-    // One theta_h row (all theta_d, phi_d, the three channels) per task; rows are independent.
-    let rows: Vec<Vec<[f32; 3]>> = (0..N_THETA_H)
-        .into_par_iter()
-        .map(|i| {
+    // One theta_h row (all theta_d, phi_d) of the three channels per task: a row of cells is
+    // contiguous in each channel's plane, and rows are independent.
+    let (red, rest) = out.split_at_mut(CELLS);
+    let (green, blue) = rest.split_at_mut(CELLS);
+    red.par_chunks_mut(ROW)
+        .zip(green.par_chunks_mut(ROW))
+        .zip(blue.par_chunks_mut(ROW))
+        .enumerate()
+        .for_each(|(i, ((r, g), b))| {
             let source = Source::new(i, s);
-            (0..N_THETA_D * N_PHI_D)
-                .map(|jk| {
-                    let (j, k) = (jk / N_PHI_D, jk % N_PHI_D);
-                    let cell = cell_index(i, j, k);
-                    let factor = source.factor(j, k, alpha, roughness);
-                    std::array::from_fn(|c| {
-                        let t = values[c * CELLS + cell];
-                        if t < 0.0 {
-                            return INVALID_VALUE;
-                        }
-                        let base = t.min(floor[c]);
-                        let specular = factor
-                            .and_then(|f| source.specular(values, c, j, k, floor[c]).map(|v| f * v))
-                            .unwrap_or(0.0);
-                        base + specular as f32
-                    })
-                })
-                .collect()
-        })
-        .collect();
-    for (i, row) in rows.iter().enumerate() {
-        for (jk, rgb) in row.iter().enumerate() {
-            let cell = cell_index(i, jk / N_PHI_D, jk % N_PHI_D);
-            for c in 0..3 {
-                out[c * CELLS + cell] = rgb[c];
+            let mut planes = [r, g, b];
+            for jk in 0..ROW {
+                let (j, k) = (jk / N_PHI_D, jk % N_PHI_D);
+                let cell = cell_index(i, j, k);
+                let factor = source.factor(j, k, alpha, roughness);
+                for (c, plane) in planes.iter_mut().enumerate() {
+                    let t = values[c * CELLS + cell];
+                    if t < 0.0 {
+                        continue; // stays invalid
+                    }
+                    let specular = factor
+                        .and_then(|f| source.specular(values, c, j, k, floor[c]).map(|v| f * v))
+                        .unwrap_or(0.0);
+                    plane[jk] = t.min(floor[c]) + specular as f32;
+                }
             }
-        }
-    }
+        });
     MerlTable::from_values(out)
         .map_err(|e| EvalError::Invalid(format!("stretching the highlight: the edited table: {e}")))
 }
