@@ -124,7 +124,8 @@ class Model:
         mode: Optional[str] = None,
     ) -> Table:
         """§5.1: set or scale the diffuse albedo, specular albedo or roughness, as
-        `experiments edit`; `mode`: residual (default), paper, transfer or analytic."""
+        `experiments edit`; `mode`: stretch (default, no network), residual, paper, transfer or
+        analytic."""
     def interpolate(self, a: ArrayLike, b: ArrayLike, steps: int = 9) -> npt.NDArray[np.float32]:
         """Fig. 10's latent path from `a` to `b`: (steps, 3, 90, 90, 180)."""
     def recover(self, image: Union[PathLike, ArrayLike]) -> Table:

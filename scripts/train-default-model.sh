@@ -7,8 +7,9 @@
 #    and, with `--add-collections`, nielsen2015, the RGL fits and the real RGL measurements (the
 #    `slice` preset's 60 epochs over them and their channel permutations and mixtures), into
 #    WORK/default; ADD_COLLECTIONS= (empty) trains on `merl` alone;
-# 2. its attribute regressor (§5.1, eq. 7) on the `merl` materials: `experiments
-#    train-regressor`, into WORK/default/regressor;
+# 2. its attribute regressor (§5.1, eq. 7) on the `merl` materials and the first 1000 materials
+#    of the corpus generator (`experiments corpus --count 1000 --seed 0`, into WORK/corpus;
+#    `experiments train-regressor --corpus`), into WORK/default/regressor;
 # 3. the recovery CNN (§5.2): a render set of 6,400 64-px images of the `merl` materials
 #    (`experiments render-set --seed 200`), then `experiments train-recovery`, into
 #    WORK/default/recovery;
@@ -39,7 +40,11 @@ if [[ ! -f "$model/model/model.json" ]]; then
     fi
 fi
 if [[ ! -f "$model/regressor/deepbrdf.regressor" ]]; then
-    run train-regressor --model "$model" --collection merl
+    if [[ ! -f "$work/corpus/corpus.jsonl" ]]; then
+        run corpus --count 1000 --seed 0 --out "$work/corpus" -q
+    fi
+    run train-regressor --model "$model" --collection merl --corpus "$work/corpus/corpus.jsonl" \
+        --corpus-count 1000
 fi
 if [[ ! -f "$model/recovery/recovery.json" ]]; then
     run render-set --out "$work/set" --images 6400 --seed 200 --collection merl

@@ -263,14 +263,15 @@ impl Model {
     }
 
     /// edit(table, *, diffuse=None, diffuse_scale=None, specular=None, specular_scale=None,
-    /// roughness=None, roughness_scale=None, mode="residual") -> numpy.ndarray
+    /// roughness=None, roughness_scale=None, mode="stretch") -> numpy.ndarray
     ///
     /// §5.1: the table with its diffuse albedo, specular albedo or roughness set (`diffuse=(r,
-    /// g, b)`, `roughness=alpha`) or scaled (`*_scale=x`), through the model's regressor (eq. 7)
-    /// and decoder, as `experiments edit` does with the same options. `mode`: `residual`
-    /// (default, `Y' = Y + Phi(alpha') - Phi(alpha)`), `paper` (`Y' = Phi(alpha')`), `transfer`
-    /// (the residual edit's change carried onto the table), `analytic` or `stretch` (no network:
-    /// the fitted lobe swapped, or the table's own highlight stretched to the new roughness).
+    /// g, b)`, `roughness=alpha`) or scaled (`*_scale=x`), as `experiments edit` does with the
+    /// same options. `mode`: `stretch` (default, no network: the table's own highlight stretched
+    /// to the new roughness, the albedos as `analytic`), `analytic` (no network: the fitted lobe
+    /// swapped), or through the model's regressor (eq. 7) and decoder: `residual` (`Y' = Y +
+    /// Phi(alpha') - Phi(alpha)`), `paper` (`Y' = Phi(alpha')`), `transfer` (the residual edit's
+    /// change carried onto the table).
     #[pyo3(signature = (table, *, diffuse=None, diffuse_scale=None, specular=None,
         specular_scale=None, roughness=None, roughness_scale=None, mode=None))]
     #[allow(clippy::too_many_arguments)]

@@ -41,6 +41,11 @@ def test_edit_equals_the_command_line(experiments, model, chrome, tmp_path):
     run(experiments, "edit", "chrome", "--roughness-scale", "2", "-o", tmp_path / "cli.binary")
     deepbrdf.write_merl(tmp_path / "py.binary", model.edit(chrome, roughness_scale=2))
     same_bytes(tmp_path / "cli.binary", tmp_path / "py.binary")
+    run(experiments, "edit", "chrome", "--roughness-scale", "2", "--mode", "residual",
+        "-o", tmp_path / "cli-residual.binary")
+    deepbrdf.write_merl(tmp_path / "py-residual.binary",
+                        model.edit(chrome, roughness_scale=2, mode="residual"))
+    same_bytes(tmp_path / "cli-residual.binary", tmp_path / "py-residual.binary")
     run(experiments, "edit", "chrome", "--mode", "analytic", "--diffuse", "0.5,0.25,0.03",
         "-o", tmp_path / "cli-analytic.binary")
     edited = model.edit(chrome, mode="analytic", diffuse=(0.5, 0.25, 0.03))

@@ -77,11 +77,22 @@ fn train_a_regressor_edit_and_interpolate() {
     let edited = s(&dir.path().join("edited-paper.binary"));
     let out = util::run_in(
         dir.path(),
-        &["edit", "--model", &model, &m1, "--roughness-scale", "2", "-o", &edited],
+        &[
+            "edit",
+            "--model",
+            &model,
+            &m1,
+            "--roughness-scale",
+            "2",
+            "--mode",
+            "paper",
+            "-o",
+            &edited,
+        ],
     );
     util::assert_clean_failure(&out, "--force");
     let bad = |args: &[&str], needle: &str| {
-        let mut all = vec!["edit", "--model", &model, &m1];
+        let mut all = vec!["edit", "--model", &model, &m1, "--mode", "residual"];
         all.extend_from_slice(args);
         all.extend_from_slice(&["-o", "x.binary"]);
         let out = util::run_in(dir.path(), &all);
@@ -104,13 +115,22 @@ fn train_a_regressor_edit_and_interpolate() {
             &m1,
             "--diffuse-scale",
             "0.5",
+            "--mode",
+            "residual",
             "-o",
             "x.binary",
         ],
     );
     util::assert_clean_failure(&out, "belongs to DeepBRDF model");
-    let out = util::run_in(dir.path(), &["edit", "--model", &other, &m1, "-o", "x.binary"]);
+    let out = util::run_in(
+        dir.path(),
+        &["edit", "--model", &other, &m1, "--mode", "transfer", "-o", "x.binary"],
+    );
     util::assert_clean_failure(&out, "train-regressor");
+    // A model given to the default (stretch) edit, which uses none: refused, naming the modes.
+    let out = util::run_in(dir.path(), &["edit", "--model", &model, &m1, "-o", "x.binary"]);
+    util::assert_clean_failure(&out, "--mode residual");
+    assert!(!dir.path().join("x.binary").exists());
 
     let strip = dir.path().join("interp");
     let printed = ok(&[

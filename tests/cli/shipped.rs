@@ -38,8 +38,12 @@ fn the_shipped_model_encodes_decodes_edits_and_recovers_without_model_options() 
     assert_eq!(read_merl(&decoded).unwrap().mask(), util::material(0).mask());
 
     let edited = dir.path().join("e.binary");
-    let out = ok(&["edit", &m0, "--diffuse-scale", "0.5", "-o", &s(&edited)]);
+    let out = ok(&["edit", &m0, "--diffuse-scale", "0.5", "--mode", "residual", "-o", &s(&edited)]);
     assert!(util::stdout(&out).contains(&id), "{}", util::stdout(&out));
+    assert!(read_merl(&edited).is_ok());
+    // Without --mode: the stretch edit, which needs no network.
+    let out = ok(&["edit", &m0, "--roughness-scale", "0.5", "-o", &s(&edited), "--force"]);
+    assert!(util::stdout(&out).contains("no network, stretch edit"), "{}", util::stdout(&out));
     assert!(read_merl(&edited).is_ok());
 
     // A photo of the material (a render over black), recovered with the shipped network.
@@ -60,8 +64,10 @@ fn the_shipped_model_halves_the_diffuse_floor_when_asked_to() {
     let dir = tempfile::tempdir().unwrap();
     let material = "red-plastic";
     let edited = dir.path().join("e.binary");
-    let out =
-        util::run_in(dir.path(), &["edit", material, "--diffuse-scale", "0.5", "-o", &s(&edited)]);
+    let out = util::run_in(
+        dir.path(),
+        &["edit", material, "--diffuse-scale", "0.5", "--mode", "residual", "-o", &s(&edited)],
+    );
     assert!(out.status.success(), "{}", util::stderr(&out));
     let (_, original) = load_material(material, &Cache::disabled()).unwrap();
     let before = Lobe::of(&original).unwrap();

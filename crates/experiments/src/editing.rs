@@ -9,7 +9,9 @@ use deepbrdf_data::dataset::Dataset;
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::attributes::{self, Attributes, FitConfig};
 use deepbrdf_eval::baseline::{BaselineBasis, BaselineCodec, MappingKind};
-pub use deepbrdf_eval::editing::{blend, blend_tables, EditMode, ModelCodec, Space, DEFAULT_MODE};
+pub use deepbrdf_eval::editing::{
+    blend, blend_tables, EditMode, ModelCodec, Space, DEFAULT_LATENT_MODE, DEFAULT_MODE,
+};
 use deepbrdf_eval::harness::Codec as _;
 use deepbrdf_model::burn::tensor::Device;
 use deepbrdf_model::regressor::{Regressor, RegressorData, Target, TargetKind};

@@ -32,6 +32,6 @@ pub use measures::{
 pub use request::{ColourEdit, Edit, EditedAttribute, ScalarEdit};
 pub use space::{
     blend, blend_tables, edit_material, path_weights, EditMode, Edited, ModelCodec, Space,
-    DEFAULT_MODE,
+    DEFAULT_LATENT_MODE, DEFAULT_MODE,
 };
 pub use stretch::{stretch_edit, stretch_roughness};

@@ -100,9 +100,14 @@ impl FromStr for EditMode {
     }
 }
 
-/// The default mode: the residual edit. It keeps an unedited material as it is, which the
-/// paper's edit does not (docs/editing.md has the measured comparison).
-pub const DEFAULT_MODE: EditMode = EditMode::Residual;
+/// The default edit of a table (`experiments edit`, `Model.edit`): the stretch edit, the only
+/// one whose roughness edits widen and narrow the highlight as asked on held-out measured
+/// materials without leaving a dark hole (docs/editing.md has the measured comparison).
+pub const DEFAULT_MODE: EditMode = EditMode::Stretch;
+
+/// The default edit where the result must stay a latent (the browser editor, `bench edit`):
+/// the residual edit, which keeps an unedited material as it is, as the paper's edit does not.
+pub const DEFAULT_LATENT_MODE: EditMode = EditMode::Residual;
 
 /// A DeepBRDF model borrowed as a [`Codec`] (eq. (2) to encode, eq. (3) to decode), mapping
 /// each table as it comes (the harness' [`crate::deep::DeepCodec`] caches the mapping instead).

@@ -30,7 +30,7 @@ pub struct Args {
     /// residual edit's change carried onto the table itself; analytic: the table's fitted
     /// Lambertian + GGX model swapped for the edited one, no network; stretch: the table's own
     /// highlight stretched to the new roughness and the albedos edited as analytic, no network
-    /// [default: residual].
+    /// [default: stretch].
     #[arg(long, value_parser = editing::mode_parser(&EditMode::ALL))]
     pub mode: Option<EditMode>,
     /// Output MERL .binary file.
@@ -123,6 +123,15 @@ pub fn describe(a: &Attributes) -> String {
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let edit = args.edit.edit()?;
+    let mode = args.mode.unwrap_or(DEFAULT_MODE);
+    if !mode.needs_network()
+        && (args.editor.model.model.is_some() || args.editor.regressor.is_some())
+    {
+        bail!(
+            "the {mode} edit uses no model or regressor: give --mode residual, paper or transfer \
+             to edit through --model/--regressor"
+        );
+    }
     for path in std::iter::once(&args.output).chain(args.render.as_ref()) {
         if path.exists() && !args.force {
             bail!("{} exists; pass --force to replace it", path.display());
@@ -136,7 +145,6 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let original = editing::attributes_of(&table, &name, &fit)?;
     // Checked before the model loads: a bad value fails at once.
     edit.apply(&original).with_context(|| format!("editing {name}"))?;
-    let mode = args.mode.unwrap_or(DEFAULT_MODE);
     let (edited, by) = match mode.needs_network() {
         false => (edit_material(&table, &original, &edit, mode, None)?, "no network".to_string()),
         true => {

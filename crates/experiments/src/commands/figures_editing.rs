@@ -179,11 +179,15 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             .collect();
         let reference = ImageRelae::new(&set.tables[g], &ImageRelaeConfig::default())?;
         let mut rows = Vec::new();
-        for mode in [EditMode::Paper, EditMode::Residual] {
+        for mode in [EditMode::Paper, EditMode::Residual, EditMode::Stretch] {
             let mut tables = vec![set.tables[g].clone()];
             tables.extend(sweep(&deep, &set.tables[g], &attrs[g], &edits, mode)?);
             let images = interpolate::render_all(&reference, &tables)?;
-            rows.push(Path3 { name: format!("DeepBRDF {}", mode.name()), tables, images });
+            let name = match mode.needs_network() {
+                true => format!("DeepBRDF {}", mode.name()),
+                false => mode.name().to_string(),
+            };
+            rows.push(Path3 { name, tables, images });
         }
         let refs: Vec<&Path3> = rows.iter().collect();
         let captions = |row: usize, i: usize| match i {
@@ -194,7 +198,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         sheet.write_figure(&args.out.join("fig12_diffuse.jpg"))?;
         let _ = write!(
             md,
-            "\n## Fig. 12: diffuse albedo of gray-plastic\n\n![Fig. 12](fig12_diffuse.jpg)\n\n{}\n\nRows: the paper's edit, the residual edit; first column the measurement. Requested vs re-estimated diffuse albedo:\n\n| edit | requested | paper: achieved | residual: achieved |\n| --- | --- | --- | --- |\n",
+            "\n## Fig. 12: diffuse albedo of gray-plastic\n\n![Fig. 12](fig12_diffuse.jpg)\n\n{}\n\nRows: the paper's edit, the residual edit (DeepBRDF), the stretch edit (no network: the diffuse albedo as the analytic edit sets it); first column the measurement. Requested vs re-estimated diffuse albedo:\n\n| edit | requested | paper: achieved | residual: achieved | stretch: achieved |\n| --- | --- | --- | --- | --- |\n",
             interpolate::figure_caption(&figure, noise)
         );
         for (i, (name, c)) in colours.iter().enumerate() {
@@ -210,8 +214,8 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                 .collect::<anyhow::Result<_>>()?;
             let _ = writeln!(
                 md,
-                "| {name} | {:.3} {:.3} {:.3} | {} | {} |",
-                c[0], c[1], c[2], got[0], got[1]
+                "| {name} | {:.3} {:.3} {:.3} | {} | {} | {} |",
+                c[0], c[1], c[2], got[0], got[1], got[2]
             );
         }
 
@@ -236,32 +240,37 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             let edits: Vec<Edit> = usable.iter().map(|(_, e)| *e).collect();
             let reference = ImageRelae::new(&set.tables[m], &ImageRelaeConfig::default())?;
             let mut rows = Vec::new();
-            for rep in &methods {
-                for mode in [EditMode::Paper, EditMode::Residual] {
-                    let tables = sweep(rep, &set.tables[m], a, &edits, mode)?;
-                    let got: Vec<f64> = tables
-                        .iter()
-                        .map(|t| Ok(editing::attributes_of(t, material, &fit)?.roughness))
-                        .collect::<anyhow::Result<_>>()?;
-                    let requested: Vec<String> =
-                        usable.iter().map(|(s, _)| format!("{:.3}", a.roughness * s)).collect();
-                    let shown: Vec<String> = got.iter().map(|r| format!("{r:.3}")).collect();
-                    let _ = writeln!(
-                        sweeps_md,
-                        "| {material} | {} | {} | {} | {} | {} |",
-                        rep.name,
-                        mode.name(),
-                        requested.join(" "),
-                        shown.join(" "),
-                        if is_monotone(&got, true, 0.0) { "yes" } else { "no" }
-                    );
-                    let images = interpolate::render_all(&reference, &tables)?;
-                    rows.push(Path3 {
-                        name: format!("{} {}", rep.name, mode.name()),
-                        tables,
-                        images,
-                    });
-                }
+            // Each representation's paper and residual edits, then the stretch edit (no
+            // network) once.
+            let runs = methods
+                .iter()
+                .flat_map(|rep| [(*rep, EditMode::Paper), (*rep, EditMode::Residual)])
+                .chain([(&deep, EditMode::Stretch)]);
+            for (rep, mode) in runs {
+                let rep_name = if mode.needs_network() { rep.name } else { "-" };
+                let tables = sweep(rep, &set.tables[m], a, &edits, mode)?;
+                let got: Vec<f64> = tables
+                    .iter()
+                    .map(|t| Ok(editing::attributes_of(t, material, &fit)?.roughness))
+                    .collect::<anyhow::Result<_>>()?;
+                let requested: Vec<String> =
+                    usable.iter().map(|(s, _)| format!("{:.3}", a.roughness * s)).collect();
+                let shown: Vec<String> = got.iter().map(|r| format!("{r:.3}")).collect();
+                let _ = writeln!(
+                    sweeps_md,
+                    "| {material} | {} | {} | {} | {} | {} |",
+                    rep_name,
+                    mode.name(),
+                    requested.join(" "),
+                    shown.join(" "),
+                    if is_monotone(&got, true, 0.0) { "yes" } else { "no" }
+                );
+                let images = interpolate::render_all(&reference, &tables)?;
+                let name = match mode.needs_network() {
+                    true => format!("{} {}", rep.name, mode.name()),
+                    false => mode.name().to_string(),
+                };
+                rows.push(Path3 { name, tables, images });
             }
             let refs: Vec<&Path3> = rows.iter().collect();
             let captions = |row: usize, i: usize| format!("{} x{:.2}", rows[row].name, usable[i].0);

@@ -3,7 +3,7 @@
 //! path), the 7 attributes as an [`Edit`] (checked against the material by [`Edit::apply`],
 //! the editing library's validation), a blend weight in [0, 1], and the preview scene (shape,
 //! sun position, turbidity) built into a [`SceneConfig`].
-use crate::editing::{EditMode, DEFAULT_MODE};
+use crate::editing::{EditMode, DEFAULT_LATENT_MODE};
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_eval::editing::{ColourEdit, Edit, ScalarEdit};
 use deepbrdf_render::{LightSpec, Projection, SceneConfig, Shape};
@@ -216,7 +216,7 @@ impl EditRequest {
             }
         };
         let mode = match self.mode.as_deref() {
-            None => DEFAULT_MODE,
+            None => DEFAULT_LATENT_MODE,
             Some(name) => match name.parse::<EditMode>().map_err(|e| bad(e.to_string()))? {
                 m if EditMode::LATENT.contains(&m) => m,
                 m => {
@@ -360,7 +360,7 @@ mod tests {
             scene: SceneChoice::default(),
         };
         let e = r.check(&c).unwrap();
-        assert_eq!(e.mode, DEFAULT_MODE);
+        assert_eq!(e.mode, DEFAULT_LATENT_MODE);
         assert_eq!(e.scene, SceneConfig::default());
         assert_eq!(e.edit.diffuse, Some(ColourEdit::Set([0.1, 0.2, 0.3])));
         r.blend.as_mut().unwrap().t = 1.5;

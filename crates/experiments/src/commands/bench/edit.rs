@@ -5,7 +5,7 @@
 //! Without an edit option the edit is roughness x0.5.
 use crate::commands::edit::EditArgs;
 use crate::data_args::CacheArg;
-use crate::editing::{self, EditMode, EditorArg, ModelCodec, Space, DEFAULT_MODE};
+use crate::editing::{self, EditMode, EditorArg, ModelCodec, Space, DEFAULT_LATENT_MODE};
 use anyhow::Context;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::{Progress, Silent};
@@ -53,7 +53,7 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     if edit == Edit::default() {
         edit.roughness = Some(ScalarEdit::Scale(0.5));
     }
-    let mode = args.mode.unwrap_or(DEFAULT_MODE);
+    let mode = args.mode.unwrap_or(DEFAULT_LATENT_MODE);
     let space = Space { codec: &codec, regressor: &regressor };
     let preview = ImageRelaeConfig::default();
     let scene = preview.scene.build()?;
