@@ -21,7 +21,8 @@ fn figures_generalize_writes_fig9_with_both_methods_relae() {
     util::assert_clean_failure(&refused, "--ipca-data");
     let o = util::run_in(
         dir.path(),
-        &[&args[..], &["--ipca-data", &s(&data), "--out", &s(&out)]].concat(),
+        &[&args[..], &["--ipca-data", &s(&data), "--out", &s(&out), "--size", "64", "--spp", "4"]]
+            .concat(),
     );
     assert!(o.status.success(), "{}", util::stderr(&o));
     let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
@@ -32,5 +33,5 @@ fn figures_generalize_writes_fig9_with_both_methods_relae() {
         assert!(v.iter().all(|x| x.is_finite() && *x > 0.0), "{line}");
     }
     assert!(summary.contains("| n3 |") && summary.contains("**mean**"), "{summary}");
-    assert!(out.join("fig9.png").is_file());
+    assert!(out.join("fig9.jpg").is_file());
 }

@@ -172,6 +172,8 @@ fn render_set_train_recovery_and_recover_chain() {
             ("--size", "16".into()),
             ("--spp", "2".into()),
             ("--nn-spp", "1".into()),
+            ("--figure-size", "32".into()),
+            ("--figure-spp", "2".into()),
         ] {
             a.push(k.into());
             a.push(v);
@@ -187,7 +189,8 @@ fn render_set_train_recovery_and_recover_chain() {
     }
     let csv = std::fs::read_to_string(figures.join("per_image.csv")).unwrap();
     assert_eq!(csv.lines().count(), 4, "{csv}");
-    for f in ["fig16.png", "per_material_held-out.svg"] {
+    assert!(summary.contains("Render noise"), "{summary}");
+    for f in ["fig16.jpg", "per_material_held-out.svg"] {
         assert!(figures.join(f).is_file(), "{f}: {}", util::stderr(&out));
     }
     // A test set that shares materials with the training set is not held out.

@@ -1,5 +1,6 @@
-//! The reconstruction loss of eq. (4) with the L2 norm (§3.2 "Loss Function"): only valid cells
-//! count, through the *mask* function, and the squared error is averaged over them.
+//! The reconstruction loss of eq. (4) (§3.2 "Loss Function"): only valid cells count, through
+//! the *mask* function, and the error, squared (L2, the paper's choice) or absolute (L1, which
+//! its Fig. 4 compares), is averaged over them.
 //!
 //! Eq. (4) sums `||mask(g(f(X))) - mask(X)||` over the training set; we use the mean over valid
 //! values of the squared difference, which has the same minimiser, keeps the learning rate
@@ -14,6 +15,38 @@ use deepbrdf_data::layout::layout_index;
 use deepbrdf_data::mapping::EPSILON;
 use deepbrdf_data::merl::grid::cos_weights;
 use deepbrdf_data::merl::{cell_index, N_PHI_D, N_THETA_D, N_THETA_H};
+use serde::{Deserialize, Serialize};
+
+/// The norm of eq. (4): "evaluated either under L1 or L2" (§3.2); the paper keeps L2 and
+/// shows the difference in its Fig. 4.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LossNorm {
+    /// The squared error (the paper's and the default).
+    #[default]
+    L2,
+    /// The absolute error.
+    L1,
+}
+
+impl LossNorm {
+    /// The per-value error of the differences `diff`: their squares (L2) or absolute values
+    /// (L1).
+    pub fn error<const D: usize>(self, diff: Tensor<D>) -> Tensor<D> {
+        match self {
+            Self::L2 => diff.clone() * diff,
+            Self::L1 => diff.abs(),
+        }
+    }
+
+    /// The norm's name in configurations and results (`l2`, `l1`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::L2 => "l2",
+            Self::L1 => "l1",
+        }
+    }
+}
 
 /// Mean squared error over the cells where `mask` is 1 (eq. 4, L2).
 ///
@@ -30,22 +63,23 @@ pub fn masked_mse<const D: usize>(
     (diff.clone() * diff).sum() / valid // [1]
 }
 
-/// Eq. (4), L2, for a network predicting deviations from a fixed offset mu: with the output
-/// `deviation + mu`, `((output - x) * mask)^2 = (deviation * mask - (x - mu) * mask)^2`, so the
+/// Eq. (4) under `norm` for a network predicting deviations from a fixed offset mu: with the
+/// output `deviation + mu`, `(output - x) * mask = deviation * mask - (x - mu) * mask`, so the
 /// offset never enters the graph. `centred_target` is `(x - mu) * mask`; `valid` counts the
 /// valid values (the sum of `mask`, known before the batch is built).
 ///
 /// # Shapes
 /// - deviation, centred_target, mask: `[batch, 540, 90, 90]`
 /// - output: `[1]`
-pub fn masked_mse_centred(
+pub fn masked_error_centred(
     deviation: Tensor<4>,
     centred_target: Tensor<4>,
     mask: Tensor<4>,
     valid: f64,
+    norm: LossNorm,
 ) -> Tensor<1> {
     let diff = deviation * mask - centred_target; // [batch, 540, 90, 90]
-    (diff.clone() * diff).sum().div_scalar(valid.max(1.0)) // [1]
+    norm.error(diff).sum().div_scalar(valid.max(1.0)) // [1]
 }
 
 /// The image-space weights `(S_c / R)^(2 power)` of the three colour channels of a mapped layout
@@ -118,10 +152,38 @@ mod tests {
         assert!(valid > 60.0 && valid < 120.0, "{valid} valid cells");
         let plain: f32 =
             masked_mse(dev.clone() + mu.clone(), x.clone(), mask.clone()).into_scalar();
-        let centred: f32 =
-            masked_mse_centred(dev, (x - mu) * mask.clone(), mask, f64::from(valid)).into_scalar();
+        let centred: f32 = masked_error_centred(
+            dev.clone(),
+            (x.clone() - mu.clone()) * mask.clone(),
+            mask.clone(),
+            f64::from(valid),
+            LossNorm::L2,
+        )
+        .into_scalar();
         assert!(plain > 0.1, "{plain}");
         assert!((plain - centred).abs() <= 1e-5 * plain.abs(), "{plain} vs {centred}");
+        // L1: the mean absolute error over the valid cells.
+        let absolute: f32 =
+            ((dev.clone() + mu.clone() - x.clone()).abs() * mask.clone()).sum().into_scalar();
+        let l1: f32 = masked_error_centred(
+            dev,
+            (x - mu) * mask.clone(),
+            mask,
+            f64::from(valid),
+            LossNorm::L1,
+        )
+        .into_scalar();
+        let want = absolute / valid;
+        assert!((l1 - want).abs() <= 1e-5 * want, "{l1} vs {want}");
+        assert!((l1 - centred).abs() > 1e-3, "L1 {l1} and L2 {centred} differ");
+    }
+
+    #[test]
+    fn loss_norms_are_named_in_lower_case() {
+        assert_eq!(serde_json::to_string(&LossNorm::L1).unwrap(), "\"l1\"");
+        assert_eq!(serde_json::from_str::<LossNorm>("\"l2\"").unwrap(), LossNorm::L2);
+        assert!(serde_json::from_str::<LossNorm>("\"l3\"").is_err());
+        assert_eq!(LossNorm::default().name(), "l2");
     }
 
     #[test]

@@ -17,6 +17,7 @@ use crate::autoencoder::convolutional::step::gradients;
 use crate::autoencoder::AutoencoderConfig;
 use crate::codec::DeepBrdf;
 use crate::error::{ModelError, Result};
+use crate::loss::LossNorm;
 use crate::training_set::TrainingSet;
 use deepbrdf_data::merl::grid::valid_mask;
 
@@ -65,8 +66,16 @@ pub fn training_steps(
     let mut runs = Vec::with_capacity(steps);
     for step in 0..=steps {
         let start = Instant::now();
-        let (value, grads) =
-            gradients(&model, &set, &indices, None, offset.as_deref(), threads, &device);
+        let (value, grads) = gradients(
+            &model,
+            &set,
+            &indices,
+            None,
+            offset.as_deref(),
+            threads,
+            LossNorm::L2,
+            &device,
+        );
         model = optim.step_multi(1e-5, model, grads);
         device.sync().map_err(|e| ModelError::Invalid(format!("device error: {e:?}")))?;
         if !value.is_finite() {

@@ -98,6 +98,9 @@ pub enum Command {
     /// Fig. 9: materials no representation was fitted to (default: the real RGL measurements),
     /// as measured, as DeepBRDF and as IPCA reconstruct them, with the image RelAE of each.
     FiguresGeneralize(commands::figures_generalize::Args),
+    /// Fig. 4: the same network trained with the L2 and the L1 loss (`train --loss l1`), each
+    /// material as measured and as each model reconstructs it, with the image RelAE of each.
+    FiguresLoss(commands::figures_loss::Args),
     /// Figs. 5 and 6: the materials' latents in their principal plane, and a few materials
     /// reconstructed by DeepBRDF, PCA and IPCA at several k, with the image RelAE of each.
     FiguresQuality(commands::figures_quality::Args),

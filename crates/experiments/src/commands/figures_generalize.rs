@@ -3,7 +3,8 @@
 //! seven real RGL measurements): each material rendered as measured, as DeepBRDF reconstructs it
 //! (eq. 2 then eq. 3) and as IPCA does at the model's k, IPCA fitted on the model's training
 //! data; the image RelAE of each reconstruction under its caption (the harness's measure,
-//! [`ImageRelae`]: the preview sphere, sun and sky).
+//! [`ImageRelae`]: the preview sphere, sun and sky), rendered at the figure settings
+//! (`--size`, `--spp`, `--seed`), with the renderer's noise measured beside it.
 use crate::data_args::{load_added, CacheArg};
 use crate::editing::ModelCodec;
 use crate::model_arg::ModelArg;
@@ -14,7 +15,7 @@ use deepbrdf_data::files::write_atomic;
 use deepbrdf_data::Progress;
 use deepbrdf_eval::baseline::{BaselineBasis, MappingKind};
 use deepbrdf_eval::harness::Codec;
-use deepbrdf_eval::metrics::{relae, ImageRelae, ImageRelaeConfig};
+use deepbrdf_eval::metrics::{relae, ImageRelae};
 use deepbrdf_eval::stats::finite_mean;
 use deepbrdf_model::DeepBrdf;
 use deepbrdf_render::sheet::{contact_sheet, SheetConfig, Tile};
@@ -40,6 +41,8 @@ pub struct Args {
     /// Output folder.
     #[arg(long, value_name = "DIR", default_value = "results/fig9")]
     pub out: PathBuf,
+    #[command(flatten)]
+    pub figure: crate::figure_arg::FigureArg,
     #[command(flatten)]
     pub cache: CacheArg,
 }
@@ -72,11 +75,13 @@ fn model_collections(
 /// One material's row.
 struct Row {
     material: String,
+    noise: f64,
     deepbrdf: f64,
     ipca: f64,
 }
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
+    let config = args.figure.config()?;
     let device = crate::device_arg::device()?;
     let model = DeepBrdf::load(&args.model.dir()?, &device)?;
     let k = model.k();
@@ -125,11 +130,14 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let tonemap = Tonemap::default();
     let srgb = |img: &deepbrdf_render::Image| img.to_srgb8(&tonemap, [0, 0, 0]);
     let (mut originals, mut deeps, mut ipcas, mut rows) = (vec![], vec![], vec![], vec![]);
-    progress.start(shown.len() as u64, "rendering");
+    progress.start(4 * shown.len() as u64, "rendering Fig. 9");
     for (name, table) in shown.names.iter().zip(&shown.tables) {
-        let measure = ImageRelae::new(table, &ImageRelaeConfig::default())?;
+        let measure = ImageRelae::new(table, &config)?;
+        progress.advance(1);
+        let noise = measure.noise(table)?;
+        progress.advance(1);
         let short = name.rsplit('/').next().unwrap_or(name).to_string();
-        let mut row = Row { material: name.clone(), deepbrdf: 0.0, ipca: 0.0 };
+        let mut row = Row { material: name.clone(), noise, deepbrdf: 0.0, ipca: 0.0 };
         for (label, codec, slot, out) in [
             ("DeepBRDF", &deep as &dyn Codec, &mut row.deepbrdf, &mut deeps),
             ("IPCA", &ipca as &dyn Codec, &mut row.ipca, &mut ipcas),
@@ -138,40 +146,50 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             let image = measure.render(&reconstruction)?;
             *slot = relae(&image, measure.reference())?;
             out.push(Tile { image: srgb(&image), caption: format!("{label}: RelAE {:.3}", *slot) });
+            progress.advance(1);
         }
         originals.push(Tile { image: srgb(measure.reference()), caption: short });
         rows.push(row);
-        progress.advance(1);
     }
     progress.finish();
     let columns = rows.len() as u32;
     let tiles: Vec<Tile> = originals.into_iter().chain(deeps).chain(ipcas).collect();
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
-    contact_sheet(&tiles, &SheetConfig { columns, ..Default::default() })?
-        .write_png(&args.out.join("fig9.png"))?;
+    let sheet = SheetConfig { columns, caption_height: 22, font_px: 15, ..Default::default() };
+    contact_sheet(&tiles, &sheet)?.write_figure(&args.out.join("fig9.jpg"))?;
 
-    let mut csv = String::from("material,relae_deepbrdf,relae_ipca\n");
+    let max_noise = rows.iter().map(|r| r.noise).fold(0.0, f64::max);
+    let mut csv = String::from("material,render_noise,relae_deepbrdf,relae_ipca\n");
     let mut md = format!(
         "Fig. 9 on {} ({} materials), written by `experiments figures-generalize`: DeepBRDF \
          model {} (k = {k}, trained on {}) and IPCA at k = {k} fitted on {} ({} materials); \
-         image RelAE on the preview sphere under sun and sky (128 px, 16 spp).\n\n\
-         ![Fig. 9](fig9.png)\n\n| material | DeepBRDF | IPCA |\n| --- | ---: | ---: |\n",
+         rows: as measured, DeepBRDF, IPCA; image RelAE on the preview sphere under sun and sky \
+         ({size} px, {spp} spp, Sobol points, seed {seed}). Render noise: the image RelAE \
+         between two renders of the measurement with seeds {seed} and {seed2}, at most \
+         {max_noise:.4}; each reconstruction's render shares its random numbers with the \
+         measurement's, so its noise is below that.\n\n\
+         ![Fig. 9](fig9.jpg)\n\n| material | render noise | DeepBRDF | IPCA |\n\
+         | --- | ---: | ---: | ---: |\n",
         shown.label,
         shown.len(),
         model.id(),
         model.provenance().data_label,
         train.label,
-        train.len()
+        train.len(),
+        size = config.render.size,
+        spp = config.render.spp,
+        seed = config.render.seed,
+        seed2 = config.next_seed().render.seed,
     );
     for r in &rows {
-        writeln!(csv, "{},{:.6},{:.6}", r.material, r.deepbrdf, r.ipca)?;
-        writeln!(md, "| {} | {:.4} | {:.4} |", r.material, r.deepbrdf, r.ipca)?;
+        writeln!(csv, "{},{:.6},{:.6},{:.6}", r.material, r.noise, r.deepbrdf, r.ipca)?;
+        writeln!(md, "| {} | {:.4} | {:.4} | {:.4} |", r.material, r.noise, r.deepbrdf, r.ipca)?;
     }
     let (d, i) =
         (finite_mean(rows.iter().map(|r| r.deepbrdf)), finite_mean(rows.iter().map(|r| r.ipca)));
     let wins = rows.iter().filter(|r| r.deepbrdf < r.ipca).count();
-    writeln!(md, "| **mean** | **{d:.4}** | **{i:.4}** |")?;
+    writeln!(md, "| **mean** | | **{d:.4}** | **{i:.4}** |")?;
     writeln!(md, "\nDeepBRDF is below IPCA on {wins} of {} materials.", rows.len())?;
     if let Some(note) = &in_sample {
         writeln!(md, "\n**Note**: {note}.")?;
@@ -179,6 +197,6 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     write_atomic(&args.out.join("fig9.csv"), csv.as_bytes())?;
     write_atomic(&args.out.join("summary.md"), md.as_bytes())?;
     print!("{md}");
-    eprintln!("wrote {}/fig9.png, fig9.csv, summary.md", args.out.display());
+    eprintln!("wrote {}/fig9.jpg, fig9.csv, summary.md", args.out.display());
     Ok(())
 }

@@ -11,7 +11,9 @@
 //! training materials). Each recovered table and the true one are rendered in a *novel* scene
 //! (another shape, view and sky than the input's: the input view alone rewards copying its
 //! highlights) and compared by image RelAE; the mapped-space (eq. 1) MSE of the tables is
-//! reported beside it.
+//! reported beside it. The figures re-render the shown tables at `--figure-size` and
+//! `--figure-spp` (Sobol points) and state the renderer's noise there; the input column is the
+//! image as the network sees it.
 use crate::data_args::CacheArg;
 use crate::model_arg::ModelArg;
 use crate::recovery_inputs::{load_tables, set_images};
@@ -19,7 +21,7 @@ use anyhow::{bail, Context};
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::figures::{write_chart, LineChart, Series};
 use deepbrdf_eval::harness::{Measure, Yardstick};
-use deepbrdf_eval::metrics::{ImageRelae, ImageRelaeConfig};
+use deepbrdf_eval::metrics::{relae, ImageRelae, ImageRelaeConfig};
 use deepbrdf_eval::recovery::{
     attributes_from_targets, mean_table, nearest_materials, novel_scene,
 };
@@ -67,6 +69,13 @@ pub struct Args {
     /// every input's scene: the costly part).
     #[arg(long, default_value_t = 4)]
     pub nn_spp: u32,
+    /// Side of the figures' rendered tiles (Figs. 16 and 17; the inputs are shown at their own
+    /// side, enlarged).
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(16..=1024))]
+    pub figure_size: u32,
+    /// Samples per pixel of the figures' renders (Sobol points).
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub figure_spp: u32,
     #[command(flatten)]
     pub cache: CacheArg,
 }
@@ -87,7 +96,34 @@ struct Shown {
     input: Srgb8Image,
     truth: Srgb8Image,
     recovered: [Srgb8Image; 2],
+    /// Image RelAE of the two recovered renders against the truth's, at the figure settings.
+    relae: [f64; 2],
+    /// The renderer's noise at the figure settings: the truth rendered with two seeds.
+    noise: f64,
     material: String,
+}
+
+/// Renders `truth` and the `recovered` tables in `config`'s scene for a figure, developed by
+/// `develop`.
+fn figure_tiles(
+    truth: &MerlTable,
+    recovered: [&MerlTable; 2],
+    config: &ImageRelaeConfig,
+    develop: &dyn Fn(&deepbrdf_render::Image) -> Srgb8Image,
+    input: Srgb8Image,
+    material: &str,
+) -> anyhow::Result<Shown> {
+    let measure = ImageRelae::new(truth, config)?;
+    let [a, b] = recovered.map(|t| measure.render(t));
+    let (a, b) = (a?, b?);
+    Ok(Shown {
+        relae: [relae(&a, measure.reference())?, relae(&b, measure.reference())?],
+        noise: measure.noise(truth)?,
+        input,
+        truth: develop(measure.reference()),
+        recovered: [develop(&a), develop(&b)],
+        material: material.to_string(),
+    })
 }
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
@@ -199,40 +235,33 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                 && !shown.iter().any(|s| s.material == image.material)
             {
                 let tm = Tonemap::default();
-                shown.push(Shown {
-                    input: input_png()?,
-                    truth: relae_of.reference().to_srgb8(&tm, [0, 0, 0]),
-                    recovered: [
-                        relae_of.render(&decoded)?.to_srgb8(&tm, [0, 0, 0]),
-                        relae_of.render(&fitted)?.to_srgb8(&tm, [0, 0, 0]),
-                    ],
-                    material: image.material.clone(),
-                });
+                let config = ImageRelaeConfig {
+                    scene: novel_scene(&set, i),
+                    ..ImageRelaeConfig::figure(args.figure_size, args.figure_spp, 0)
+                };
+                shown.push(figure_tiles(
+                    t,
+                    [&decoded, &fitted],
+                    &config,
+                    &|img| img.to_srgb8(&tm, [0, 0, 0]),
+                    input_png()?,
+                    &image.material,
+                )?);
             }
             if name == "held-out" && is_plane && planes.len() < 4 {
                 // Fig. 17: the plane of the input itself, re-rendered with each table.
-                let own = ImageRelaeConfig {
+                let config = ImageRelaeConfig {
                     scene: image.scene.scene,
-                    render: RenderSettings {
-                        size: set.header.size,
-                        spp: args.spp,
-                        seed: image.scene.render_seed,
-                        jitter: true,
-                        sampler: Sampler::Independent,
-                    },
+                    ..ImageRelaeConfig::figure(args.figure_size, args.figure_spp, 0)
                 };
-                let on_plane = ImageRelae::new(t, &own)?;
-                let develop =
-                    |img: &deepbrdf_render::Image| camera_png(img, image.scene.exposure, 0.0, 0);
-                planes.push(Shown {
-                    input: input_png()?,
-                    truth: develop(on_plane.reference()),
-                    recovered: [
-                        develop(&on_plane.render(&decoded)?),
-                        develop(&on_plane.render(&fitted)?),
-                    ],
-                    material: image.material.clone(),
-                });
+                planes.push(figure_tiles(
+                    t,
+                    [&decoded, &fitted],
+                    &config,
+                    &|img| camera_png(img, image.scene.exposure, 0.0, 0),
+                    input_png()?,
+                    &image.material,
+                )?);
             }
             rows.push(Row {
                 set: name.clone(),
@@ -323,54 +352,68 @@ fn write_outputs(
         writeln!(md, "![{set}, per material](per_material_{set}.svg)")?;
         per_material_chart(rows, set, &args.out.join(format!("per_material_{set}")))?;
     }
+    if !shown.is_empty() || !planes.is_empty() {
+        let noise = shown.iter().chain(planes).map(|s| s.noise).fold(0.0, f64::max);
+        writeln!(md)?;
+        writeln!(
+            md,
+            "Fig. 16 (`fig16.jpg`: held-out inputs as the network sees them, enlarged; the truth \
+             and DeepBRDF's recovery rendered in the novel scene) and Fig. 17 (`fig17.jpg`: \
+             held-out planes, the truth, DeepBRDF and the analytic baseline re-rendered in the \
+             input's own scene): {0} px, {1} spp, Sobol points, seed 0; the RelAE under a tile \
+             is at these settings. Render noise (the truth rendered with seeds 0 and 1): at \
+             most {noise:.4}.",
+            args.figure_size, args.figure_spp
+        )?;
+        writeln!(md)?;
+        writeln!(md, "![Fig. 16](fig16.jpg)")?;
+        writeln!(md)?;
+        writeln!(md, "![Fig. 17](fig17.jpg)")?;
+    }
     deepbrdf_data::files::write_atomic(&args.out.join("summary.md"), md.as_bytes())?;
     print!("{md}");
 
     let short = |m: &str| m.rsplit('/').next().unwrap_or(m).to_string();
-    let up = |img: &Srgb8Image| img.upscaled((128 / img.width.max(1)).max(1));
+    let up = |img: &Srgb8Image| img.upscaled((args.figure_size / img.width.max(1)).max(1));
+    let sheet_config = |columns: usize| SheetConfig {
+        columns: columns as u32,
+        caption_height: 22,
+        font_px: 15,
+        ..Default::default()
+    };
     if !shown.is_empty() {
         let mut tiles = Vec::new();
-        for (row, caption) in [(0, "input"), (1, "ground truth"), (2, "DeepBRDF")] {
+        for row in 0..3 {
             for s in shown {
-                let image = match row {
-                    0 => &s.input,
-                    1 => &s.truth,
-                    _ => &s.recovered[0],
+                let (image, caption) = match row {
+                    0 => (up(&s.input), short(&s.material)),
+                    1 => (s.truth.clone(), "ground truth".to_string()),
+                    _ => (s.recovered[0].clone(), format!("DeepBRDF: RelAE {:.3}", s.relae[0])),
                 };
-                let caption = if row == 0 { short(&s.material) } else { caption.to_string() };
-                tiles.push(Tile { image: up(image), caption });
+                tiles.push(Tile { image, caption });
             }
         }
-        let sheet = contact_sheet(
-            &tiles,
-            &SheetConfig { columns: shown.len() as u32, ..Default::default() },
-        )?;
-        sheet.write_png(&args.out.join("fig16.png"))?;
+        contact_sheet(&tiles, &sheet_config(shown.len()))?
+            .write_figure(&args.out.join("fig16.jpg"))?;
     }
     if !planes.is_empty() {
         let mut tiles = Vec::new();
-        for (row, caption) in
-            [(0, "input plane"), (1, "ground truth"), (2, "DeepBRDF"), (3, "analytic (GGX)")]
-        {
+        for row in 0..4 {
             for s in planes {
-                let image = match row {
-                    0 => &s.input,
-                    1 => &s.truth,
-                    2 => &s.recovered[0],
-                    _ => &s.recovered[1],
+                let (image, caption) = match row {
+                    0 => (up(&s.input), format!("{} (input)", short(&s.material))),
+                    1 => (s.truth.clone(), "ground truth".to_string()),
+                    2 => (s.recovered[0].clone(), format!("DeepBRDF: RelAE {:.3}", s.relae[0])),
+                    _ => (s.recovered[1].clone(), format!("analytic: RelAE {:.3}", s.relae[1])),
                 };
-                let caption = if row == 0 { short(&s.material) } else { caption.to_string() };
-                tiles.push(Tile { image: up(image), caption });
+                tiles.push(Tile { image, caption });
             }
         }
-        let sheet = contact_sheet(
-            &tiles,
-            &SheetConfig { columns: planes.len() as u32, ..Default::default() },
-        )?;
-        sheet.write_png(&args.out.join("fig17.png"))?;
+        contact_sheet(&tiles, &sheet_config(planes.len()))?
+            .write_figure(&args.out.join("fig17.jpg"))?;
     }
     eprintln!(
-        "wrote {}/summary.md, per_image.csv, per_material_*.svg, fig16.png, fig17.png",
+        "wrote {}/summary.md, per_image.csv, per_material_*.svg, fig16.jpg, fig17.jpg",
         args.out.display()
     );
     Ok(())

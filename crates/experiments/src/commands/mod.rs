@@ -19,6 +19,7 @@ pub mod export_bsdf;
 pub mod fetch_merl;
 pub mod figures_editing;
 pub mod figures_generalize;
+pub mod figures_loss;
 pub mod figures_quality;
 pub mod figures_recovery;
 pub mod folds;
@@ -71,6 +72,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::FiguresEditing(args) => figures_editing::run(args, &progress),
         Command::EditKnown(args) => edit_known::run(args, &progress),
         Command::FiguresGeneralize(args) => figures_generalize::run(args, &progress),
+        Command::FiguresLoss(args) => figures_loss::run(args, &progress),
         Command::FiguresQuality(args) => figures_quality::run(args, &progress),
         Command::RenderSet(args) => render_set::run(args, &progress),
         Command::TrainRecovery(args) => train_recovery::run(args, &progress),

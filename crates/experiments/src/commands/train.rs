@@ -11,6 +11,7 @@ use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::lock::FolderLock;
 use deepbrdf_data::Progress;
 use deepbrdf_model::autoencoder::Architecture;
+use deepbrdf_model::loss::LossNorm;
 use deepbrdf_model::train::{checkpoint_path, saved_config};
 use deepbrdf_model::{fit, Preset, SliceDropoutConfig, TrainConfig};
 use std::path::PathBuf;
@@ -54,6 +55,10 @@ pub struct Args {
     /// components (slice network) [default: 1].
     #[arg(long, value_name = "N")]
     pub held_passes: Option<usize>,
+    /// The norm of eq. (4): l2 (the paper's) or l1 (Fig. 4's comparison) [default: the
+    /// preset's or file's, l2].
+    #[arg(long, value_name = "NORM", value_parser = parse_norm)]
+    pub loss: Option<LossNorm>,
     /// Output directory (checkpoint, log, configuration, and the model in DIR/model).
     #[arg(long, value_name = "DIR", required_unless_present = "resume")]
     pub out: Option<PathBuf>,
@@ -78,6 +83,13 @@ pub struct Args {
 
 fn parse_preset(s: &str) -> Result<Preset, String> {
     s.parse()
+}
+
+fn parse_norm(s: &str) -> Result<LossNorm, String> {
+    [LossNorm::L2, LossNorm::L1]
+        .into_iter()
+        .find(|n| n.name() == s.trim())
+        .ok_or_else(|| format!("loss norm {s:?}: expected l2 or l1"))
 }
 
 impl Args {
@@ -108,6 +120,9 @@ impl Args {
                     .with_probability(p)
                     .with_selections(self.slice_dropout_keep.clone()),
             );
+        }
+        if let Some(norm) = self.loss {
+            config.loss_norm = Some(norm);
         }
         if let Some(passes) = self.held_passes {
             match &mut config.model.architecture {

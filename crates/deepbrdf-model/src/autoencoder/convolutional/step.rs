@@ -6,7 +6,7 @@ use burn::optim::{GradientsParams, MultiGradientsParams};
 use burn::prelude::*;
 
 use crate::autoencoder::Autoencoder;
-use crate::loss::masked_mse_centred;
+use crate::loss::{masked_error_centred, LossNorm};
 use crate::train::autoencoder::batch::{batch_tensors, Augment, Batch, SliceDropout};
 use crate::train::autoencoder::config::TrainConfig;
 use crate::train::run::TrainStep;
@@ -77,16 +77,22 @@ impl TrainStep for ConvolutionalStep<'_> {
             augment.as_ref(),
             self.offset.as_deref(),
             self.config.threads,
+            self.config.norm(),
             device,
         ))
     }
 }
 
-/// The eq. (4) loss of a batch, its squared error divided by `valid` (the valid values of the
-/// whole batch when this is a shard of it): the forward step training and benchmarks share.
-pub(crate) fn batch_loss(model: &Autoencoder, batch: Batch, valid: f64) -> Tensor<1> {
+/// The eq. (4) loss of a batch under `norm`, its error divided by `valid` (the valid values of
+/// the whole batch when this is a shard of it): the forward step training and benchmarks share.
+pub(crate) fn batch_loss(
+    model: &Autoencoder,
+    batch: Batch,
+    valid: f64,
+    norm: LossNorm,
+) -> Tensor<1> {
     let deviation = model.decode_deviation(model.encode_centred(batch.input)); // [batch, 540, 90, 90]
-    masked_mse_centred(deviation, batch.target, batch.mask, valid) // [1]
+    masked_error_centred(deviation, batch.target, batch.mask, valid, norm) // [1]
 }
 
 /// The loss and gradients of the batch `indices`, computed in `threads` shards in parallel
@@ -94,6 +100,7 @@ pub(crate) fn batch_loss(model: &Autoencoder, batch: Batch, valid: f64) -> Tenso
 /// to work). Each shard works on its own fork of the model (its own autodiff graph); the
 /// optimizer sums the shards' gradients, each normalised by the whole batch's valid values,
 /// so the step is that of the whole batch. Deterministic for a given `threads`.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn gradients(
     model: &Autoencoder,
     data: &TrainingSet,
@@ -101,13 +108,14 @@ pub(crate) fn gradients(
     augment: Option<&Augment>,
     offset: Option<&[f32]>,
     threads: usize,
+    norm: LossNorm,
     device: &Device,
 ) -> (f32, MultiGradientsParams) {
     let valid: f64 = indices.iter().map(|&i| data.valid_values(i)).sum();
     let shard = |indices: &[usize], forked: bool| {
         let model = if forked { model.clone().fork(device) } else { model.clone() };
         let batch = batch_tensors(data, indices, augment, offset, device);
-        let loss = batch_loss(&model, batch, valid);
+        let loss = batch_loss(&model, batch, valid, norm);
         let value: f32 = loss.clone().into_scalar();
         (value, GradientsParams::from_grads(loss.backward(), &model))
     };

@@ -21,7 +21,7 @@ use super::basis::{basis_t, fit_slice_basis, fit_weighted_components, project};
 use super::config::SliceConfig;
 use crate::autoencoder::Autoencoder;
 use crate::error::ModelError;
-use crate::loss::colour_weights;
+use crate::loss::{colour_weights, LossNorm};
 use crate::streamed::mapped_layout;
 use crate::train::autoencoder::batch::{centre, filled_input, SliceDropout};
 use crate::train::autoencoder::config::TrainConfig;
@@ -120,7 +120,7 @@ impl TrainStep for SliceStep<'_> {
                 }
             })
             .collect();
-        slice_gradients(model, fit, &indices, inputs, device)
+        slice_gradients(model, fit, &indices, inputs, self.config.norm(), device)
     }
 }
 
@@ -287,15 +287,20 @@ fn normalised(weights: Vec<[f64; 3]>) -> Vec<[f32; 3]> {
     weights.iter().map(|w| w.map(|v| (v * scale) as f32)).collect()
 }
 
-/// The eq. (4) loss of the samples `indices` (their coefficients' squared error, each colour
-/// channel's times its weight, plus their residuals, over their valid values) and its
-/// gradients; `inputs` are the encoder's input coefficients, the targets' or those of filled
-/// inputs.
+/// The eq. (4) loss of the samples `indices` (their coefficients' error under `norm`, each
+/// colour channel's times its weight, over their valid values; with L2 plus their residuals)
+/// and its gradients; `inputs` are the encoder's input coefficients, the targets' or those of
+/// filled inputs.
+///
+/// The basis is orthonormal, so the coefficients' L2 error is the cells' (plus the residual, a
+/// constant); their L1 error is not the cells' L1 error, but it is the same change of norm
+/// acting on the same network, which is what Fig. 4 compares.
 fn slice_gradients(
     model: &Autoencoder,
     fit: &SliceFit,
     indices: &[usize],
     inputs: Vec<f32>,
+    norm: LossNorm,
     device: &Device,
 ) -> crate::error::Result<(f32, MultiGradientsParams)> {
     let net = model
@@ -309,8 +314,8 @@ fn slice_gradients(
     let target = Tensor::<2>::from_data(TensorData::new(targets, [b, len]), device);
     let input = Tensor::<2>::from_data(TensorData::new(inputs, [b, len]), device);
     let diff = net.decode_coefficients(net.encode_coefficients(input)) - target; // [batch, 540 M]
-    let squared = diff.clone() * diff; // [batch, 540 M]
-    let squared = match &fit.weights {
+    let error = norm.error(diff); // [batch, 540 M]
+    let error = match &fit.weights {
         Some(weights) => {
             let m = net.directions();
             let values: Vec<f32> = indices
@@ -320,12 +325,15 @@ fn slice_gradients(
                     (0..len).map(move |j| w[(j / m) % 3]) // coefficient j: image j / M
                 })
                 .collect();
-            squared * Tensor::<2>::from_data(TensorData::new(values, [b, len]), device)
+            error * Tensor::<2>::from_data(TensorData::new(values, [b, len]), device)
         }
-        None => squared,
+        None => error,
     };
-    let loss = squared.sum().div_scalar(valid.max(1.0)); // [1]
+    let loss = error.sum().div_scalar(valid.max(1.0)); // [1]
     let value: f32 = loss.clone().into_scalar();
-    let value = value + (residual / valid.max(1.0)) as f32;
+    let value = match norm {
+        LossNorm::L2 => value + (residual / valid.max(1.0)) as f32,
+        LossNorm::L1 => value,
+    };
     Ok((value, on_device(GradientsParams::from_grads(loss.backward(), model), device)))
 }

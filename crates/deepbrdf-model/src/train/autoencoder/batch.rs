@@ -68,7 +68,7 @@ impl Augment<'_> {
 
 /// One training batch, prepared on the CPU: inputs and targets centred on the fixed offset
 /// and masked, `(x - mu) * mask` (just `x * mask` without an offset), as
-/// [`crate::loss::masked_mse_centred`] expects.
+/// [`crate::loss::masked_error_centred`] expects.
 pub(crate) struct Batch {
     /// `[batch, 540, 90, 90]`: the network's input (with slice dropout, the filled one).
     pub input: Tensor<4>,

@@ -13,6 +13,7 @@ use super::batch::SliceDropout;
 use crate::atomic::read_limited;
 use crate::autoencoder::{Autoencoder, AutoencoderConfig};
 use crate::error::ModelError;
+use crate::loss::LossNorm;
 use crate::train::checkpoint::{self, CHECKPOINT_FILE};
 use crate::train::config::{adam, LoopConfig};
 
@@ -59,6 +60,10 @@ pub struct TrainConfig {
     /// Slice-dropout augmentation (§3.2, Fig. 2); none in the paper's training.
     #[config(default = "None")]
     pub slice_dropout: Option<SliceDropoutConfig>,
+    /// The norm of eq. (4); none is L2, the paper's (a configuration written before the field
+    /// existed has none). L1 is for Fig. 4's comparison.
+    #[config(default = "None")]
+    pub loss_norm: Option<LossNorm>,
 }
 
 /// Slice-dropout augmentation: some training inputs lose phi_d slices, each missing slice
@@ -132,6 +137,11 @@ impl TrainConfig {
             .map_err(|e| ModelError::format(path, format!("not a training configuration: {e}")))?;
         config.validate().map_err(|e| ModelError::format(path, e.to_string()))?;
         Ok(config)
+    }
+
+    /// The norm of eq. (4) this run trains with.
+    pub fn norm(&self) -> LossNorm {
+        self.loss_norm.unwrap_or_default()
     }
 
     /// The loop's settings of this configuration.

@@ -1,0 +1,209 @@
+//! `experiments figures-loss --models DIR,DIR --data DIR [--show N]`: Fig. 4 of Hu et al.
+//! (2020), the same network trained with eq. (4) under the L2 and the L1 norm (`experiments
+//! train --loss l1`), each material rendered as measured and as each model reconstructs it
+//! (eq. 2 then eq. 3), with the image RelAE under each tile (the harness's measure,
+//! [`ImageRelae`], at the figure settings `--size`, `--spp`, `--seed`) and the renderer's noise
+//! measured beside it. A shown material a model was trained on makes the figure in-sample; the
+//! summary says so.
+use crate::data_args::CacheArg;
+use crate::editing::ModelCodec;
+use anyhow::{bail, Context};
+use deepbrdf_data::dataset::{DataSource, Dataset};
+use deepbrdf_data::files::write_atomic;
+use deepbrdf_data::Progress;
+use deepbrdf_eval::harness::Codec;
+use deepbrdf_eval::metrics::{relae, ImageRelae};
+use deepbrdf_eval::stats::finite_mean;
+use deepbrdf_model::{DeepBrdf, TrainConfig};
+use deepbrdf_render::sheet::{contact_sheet, SheetConfig, Tile};
+use deepbrdf_render::Tonemap;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The models to compare (comma-separated model directories), each labelled by the norm of
+    /// its training configuration.
+    #[arg(long, value_name = "DIR,...", value_delimiter = ',', required = true, num_args = 1..)]
+    pub models: Vec<PathBuf>,
+    /// The materials: a folder of MERL .binary files (e.g. a fold the models were not trained
+    /// on: docs/reproducing.md).
+    #[arg(long, value_name = "DIR")]
+    pub data: PathBuf,
+    /// Materials shown in the figure, evenly spaced through the folder's (all are measured).
+    #[arg(long, value_name = "N", default_value_t = 6, value_parser = clap::value_parser!(u32).range(1..=32))]
+    pub show: u32,
+    /// Output folder.
+    #[arg(long, value_name = "DIR", default_value = "results/fig4")]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub figure: crate::figure_arg::FigureArg,
+    #[command(flatten)]
+    pub cache: CacheArg,
+}
+
+/// The indices of `show` of `n` materials, evenly spaced from the first.
+fn spaced(n: usize, show: usize) -> Vec<usize> {
+    let show = show.min(n);
+    (0..show).map(|i| i * n / show).collect()
+}
+
+/// A model and the label of its norm ("L2", "L1").
+fn load(
+    dir: &PathBuf,
+    device: &deepbrdf_model::burn::tensor::Device,
+) -> anyhow::Result<(DeepBrdf, String)> {
+    let model = DeepBrdf::load(dir, device)?;
+    let config: TrainConfig = serde_json::from_value(model.provenance().train_config.clone())
+        .with_context(|| format!("reading the training configuration of {}", dir.display()))?;
+    Ok((model, config.norm().name().to_uppercase()))
+}
+
+pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
+    let config = args.figure.config()?;
+    let device = crate::device_arg::device()?;
+    let mut models = Vec::with_capacity(args.models.len());
+    for dir in &args.models {
+        models.push(load(dir, &device)?);
+    }
+    if let Some((a, _)) = models.iter().find(|(m, _)| m.k() != models[0].0.k()) {
+        bail!(
+            "the models differ in k ({} and {}): compare models of one k",
+            a.k(),
+            models[0].0.k()
+        );
+    }
+    let source = DataSource::Folder(args.data.clone());
+    let data = Dataset::load(&source, &args.cache.cache(), progress)
+        .with_context(|| format!("loading the materials {}", source.label()))?;
+    let seen: Vec<&String> = data
+        .names
+        .iter()
+        .filter(|n| models.iter().any(|(m, _)| m.provenance().trained_on(n)))
+        .collect();
+    let shown = spaced(data.len(), args.show as usize);
+
+    let tonemap = Tonemap::default();
+    let srgb = |img: &deepbrdf_render::Image| img.to_srgb8(&tonemap, [0, 0, 0]);
+    // errors[m][i]: model m on material i; tiles in rows of shown materials.
+    let mut errors = vec![Vec::with_capacity(data.len()); models.len()];
+    let (mut noise, mut tiles) = (Vec::with_capacity(data.len()), vec![]);
+    progress.start((data.len() * (2 + models.len())) as u64, "rendering Fig. 4");
+    for (i, (name, table)) in data.names.iter().zip(&data.tables).enumerate() {
+        let measure = ImageRelae::new(table, &config)?;
+        noise.push(measure.noise(table)?);
+        progress.advance(2);
+        let show = shown.contains(&i);
+        if show {
+            tiles.push(Tile { image: srgb(measure.reference()), caption: name.clone() });
+        }
+        for (m, (model, label)) in models.iter().enumerate() {
+            let codec = ModelCodec(model);
+            let image = measure.render(&codec.decode(&codec.encode(table)?)?)?;
+            let e = relae(&image, measure.reference())?;
+            errors[m].push(e);
+            if show {
+                tiles.push(Tile { image: srgb(&image), caption: format!("{label}: RelAE {e:.3}") });
+            }
+            progress.advance(1);
+        }
+    }
+    progress.finish();
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let sheet = SheetConfig {
+        columns: 1 + models.len() as u32,
+        caption_height: 22,
+        font_px: 15,
+        ..Default::default()
+    };
+    contact_sheet(&tiles, &sheet)?.write_figure(&args.out.join("fig4.jpg"))?;
+
+    let labels: Vec<&str> = models.iter().map(|(_, l)| l.as_str()).collect();
+    let mut csv = format!(
+        "material,shown,render_noise,{}\n",
+        labels.iter().map(|l| format!("relae_{}", l.to_lowercase())).collect::<Vec<_>>().join(",")
+    );
+    let mut table = format!(
+        "| material | render noise | {} |\n| --- | ---: |{}\n",
+        labels.join(" | "),
+        " ---: |".repeat(models.len())
+    );
+    for (i, name) in data.names.iter().enumerate() {
+        write!(csv, "{name},{},{:.6}", shown.contains(&i), noise[i])?;
+        write!(
+            table,
+            "| {name}{} | {:.4} |",
+            if shown.contains(&i) { " (shown)" } else { "" },
+            noise[i]
+        )?;
+        for e in &errors {
+            write!(csv, ",{:.6}", e[i])?;
+            write!(table, " {:.4} |", e[i])?;
+        }
+        csv.push('\n');
+        table.push('\n');
+    }
+    let means: Vec<f64> = errors.iter().map(|e| finite_mean(e.iter().copied())).collect();
+    writeln!(
+        table,
+        "| **mean** | | {} |",
+        means.iter().map(|m| format!("**{m:.4}**")).collect::<Vec<_>>().join(" | ")
+    )?;
+    let mut lines = String::new();
+    for (m, (model, label)) in models.iter().enumerate() {
+        let below = (0..data.len())
+            .filter(|&i| (0..models.len()).all(|o| o == m || errors[m][i] < errors[o][i]))
+            .count();
+        writeln!(
+            lines,
+            "- {label}: model {} (k = {}, {} epochs on {} materials of {}), mean image RelAE \
+             {:.4}, the lowest on {below} of {} materials.",
+            model.id(),
+            model.k(),
+            model.provenance().epochs,
+            model.provenance().materials.len(),
+            model.provenance().data_label,
+            means[m],
+            data.len()
+        )?;
+    }
+    let scope = match seen.len() {
+        0 => "none of them seen by either model in training (held out)".to_string(),
+        n => format!("**in-sample**: {n} of them are in a model's training data"),
+    };
+    let max_noise = noise.iter().copied().fold(0.0, f64::max);
+    let md = format!(
+        "Fig. 4 (L1 against L2 loss), written by `experiments figures-loss`: {} materials of \
+         {}, {scope}; {} of them shown (rows: as measured, then each model's reconstruction). \
+         Image RelAE on the preview sphere under sun and sky ({size} px, {spp} spp, Sobol points, \
+         seed {seed}). Render noise: the image RelAE between two renders of the measurement with \
+         seeds {seed} and {seed2}, at most {max_noise:.4}; each reconstruction's render shares \
+         its random numbers with the measurement's, so its noise is below that.\n\n{lines}\n\
+         ![Fig. 4](fig4.jpg)\n\n{table}",
+        data.len(),
+        source.label(),
+        shown.len(),
+        size = config.render.size,
+        spp = config.render.spp,
+        seed = config.render.seed,
+        seed2 = config.next_seed().render.seed,
+    );
+    write_atomic(&args.out.join("fig4.csv"), csv.as_bytes())?;
+    write_atomic(&args.out.join("summary.md"), md.as_bytes())?;
+    print!("{md}");
+    eprintln!("wrote {}/fig4.jpg, fig4.csv, summary.md", args.out.display());
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::spaced;
+
+    #[test]
+    fn shown_materials_are_spread_through_the_folder() {
+        assert_eq!(spaced(20, 6), vec![0, 3, 6, 10, 13, 16]);
+        assert_eq!(spaced(3, 6), vec![0, 1, 2]);
+        assert_eq!(spaced(5, 1), vec![0]);
+    }
+}
