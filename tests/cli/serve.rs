@@ -271,6 +271,23 @@ fn serve_refuses_bad_input_with_4xx_and_keeps_running() {
         values(&p["latent"]),
         "the latent downloaded is the one previewed"
     );
+    // The stretch edit edits the table: a preview without a latent, a table to download, no
+    // latent file.
+    let stretch = json!({"material": id, "roughness": 0.2, "mode": "stretch"});
+    let (status, answer) = post(base, "/api/preview", &preview(stretch.clone()));
+    assert_eq!(status, 200, "{}", text(&answer));
+    let p: Value = serde_json::from_slice(&answer).unwrap();
+    assert!(p["latent"].is_null() && p["requested"]["roughness"] == 0.2, "{p}");
+    let (status, binary) = download("binary", &stretch);
+    assert_eq!(status, 200, "{}", text(&binary));
+    assert!(deepbrdf_data::merl::MerlFile::from_bytes(&binary, Path::new("stretch")).is_ok());
+    let (status, answer) = download("latent", &stretch);
+    assert_eq!(
+        (status, text(&answer).contains("edits the table")),
+        (400, true),
+        "{}",
+        text(&answer)
+    );
 
     // Still answering; nothing written beside its cache.
     assert_eq!(get(base, "/api/info").0, 200);

@@ -105,8 +105,9 @@ impl FromStr for EditMode {
 /// materials without leaving a dark hole (docs/editing.md has the measured comparison).
 pub const DEFAULT_MODE: EditMode = EditMode::Stretch;
 
-/// The default edit where the result must stay a latent (the browser editor, `bench edit`):
-/// the residual edit, which keeps an unedited material as it is, as the paper's edit does not.
+/// The default latent edit (`bench edit`, and the browser editor's API when a request names no
+/// mode): the residual edit, which keeps an unedited material as it is, as the paper's edit
+/// does not.
 pub const DEFAULT_LATENT_MODE: EditMode = EditMode::Residual;
 
 /// A DeepBRDF model borrowed as a [`Codec`] (eq. (2) to encode, eq. (3) to decode), mapping

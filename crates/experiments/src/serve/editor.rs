@@ -14,7 +14,7 @@
 use super::request::{
     check_upload_name, Catalogue, CheckedEdit, Quality, Refusal, UPLOAD_COLLECTION,
 };
-use crate::editing::{self, ModelCodec, Space};
+use crate::editing::{self, EditMode, ModelCodec, Space};
 use crate::latent_file::LatentFile;
 use deepbrdf_data::cache::Cache;
 use deepbrdf_data::dataset::load_bundled_material;
@@ -58,7 +58,8 @@ pub const REFINED_PASSES: u32 = 8;
 const PREVIEW_SEED: u64 = 0x5eed;
 /// Materials kept open (each ~40 MB: its table, the interleaved copy, its sampler).
 const OPEN_MATERIALS: usize = 8;
-/// Decoded tables kept (17.5 MB each), by latent.
+/// Decoded tables kept (17.5 MB each), by latent; as many edited tables of the modes that
+/// edit the table itself, by edit.
 const DECODED_TABLES: usize = 4;
 /// Renders of originals kept (PNG bytes), by material and scene.
 const ORIGINAL_RENDERS: usize = 32;
@@ -204,6 +205,7 @@ struct Editor {
     shared: Arc<Shared>,
     materials: Recent<String, Arc<Material>>,
     decoded: Recent<Vec<u32>, Arc<MerlTable>>,
+    edited: Recent<String, Arc<MerlTable>>,
     scenes: Recent<String, Arc<Scene>>,
     originals: Recent<String, Arc<Vec<u8>>>,
 }
@@ -229,6 +231,7 @@ impl Editor {
             shared,
             materials: Recent::new(OPEN_MATERIALS),
             decoded: Recent::new(DECODED_TABLES),
+            edited: Recent::new(DECODED_TABLES),
             scenes: Recent::new(8),
             originals: Recent::new(ORIGINAL_RENDERS),
         }
@@ -374,6 +377,50 @@ impl Editor {
         Ok((z, requested, base, material))
     }
 
+    /// The edited table of a mode that edits the table itself (transfer, analytic, stretch;
+    /// [`Space::edit`]), from the material's table or the linear blend of the two materials'
+    /// tables, with the attributes asked for; kept for the next request with the same edit.
+    fn edited_table(
+        &mut self,
+        edit: &CheckedEdit,
+    ) -> Result<(Arc<MerlTable>, Attributes, Attributes, Arc<Material>), Failure> {
+        let (latent, base, material) = self.base(edit)?;
+        let requested = edit.edit.apply(&base).map_err(|e| Refusal::BadRequest(e.to_string()))?;
+        let key = format!("{:?}", (&edit.material, &edit.blend, edit.mode.name(), &edit.edit));
+        if let Some(t) = self.edited.get(&key) {
+            return Ok((t, requested, base, material));
+        }
+        let blended = match &edit.blend {
+            None => None,
+            Some((other, t)) => {
+                let b = self.material(other)?;
+                Some(editing::blend_tables(&material.table, &b.table, *t)?)
+            }
+        };
+        let codec = ModelCodec(&self.model);
+        let space = Space { codec: &codec, regressor: &self.regressor };
+        let table = blended.as_ref().unwrap_or(&material.table);
+        let edited = space.edit(table, &latent, &base, &edit.edit, edit.mode)?;
+        let table = Arc::new(edited.table);
+        self.edited.put(key, table.clone());
+        Ok((table, requested, base, material))
+    }
+
+    /// The edited table and, for a mode that edits the latent (paper, residual), the latent,
+    /// with the attributes asked for and the base.
+    #[allow(clippy::type_complexity)]
+    fn edited(
+        &mut self,
+        edit: &CheckedEdit,
+    ) -> Result<(Arc<MerlTable>, Option<Vec<f32>>, Attributes, Arc<Material>), Failure> {
+        if EditMode::LATENT.contains(&edit.mode) {
+            let (z, requested, _, material) = self.edited_latent(edit)?;
+            return Ok((self.decoded(&z)?, Some(z), requested, material));
+        }
+        let (table, requested, _, material) = self.edited_table(edit)?;
+        Ok((table, None, requested, material))
+    }
+
     /// The decoded table of a latent (kept for the next request with the same latent: the
     /// refined preview, a download).
     fn decoded(&mut self, z: &[f32]) -> Result<Arc<MerlTable>, Failure> {
@@ -401,10 +448,22 @@ impl Editor {
     ) -> Result<Preview, Failure> {
         let t0 = Instant::now();
         let scene = self.scene(&edit.scene)?;
-        let (z, requested, base, material) = self.edited_latent(edit)?;
-        let t1 = Instant::now();
-        self.current(generation)?;
-        let table = self.decoded(&z)?;
+        // The regressor, then the decoder; a mode that edits the table counts as a decode.
+        let (latent, requested, base, material, table, t1) =
+            match EditMode::LATENT.contains(&edit.mode) {
+                true => {
+                    let (z, requested, base, material) = self.edited_latent(edit)?;
+                    let t1 = Instant::now();
+                    self.current(generation)?;
+                    let table = self.decoded(&z)?;
+                    (Some(z), requested, base, material, table, t1)
+                }
+                false => {
+                    let t1 = Instant::now();
+                    let (table, requested, base, material) = self.edited_table(edit)?;
+                    (None, requested, base, material, table, t1)
+                }
+            };
         let t2 = Instant::now();
         self.current(generation)?;
         let (image, settings, achieved) = match quality {
@@ -433,7 +492,7 @@ impl Editor {
             quality,
             size: settings.size,
             spp: settings.spp,
-            latent: z,
+            latent,
             requested: (&requested).into(),
             base: (&base).into(),
             achieved,
@@ -447,7 +506,7 @@ impl Editor {
     }
 
     fn download(&mut self, edit: &CheckedEdit, what: Download) -> Result<DownloadFile, Failure> {
-        let (z, _, _, material) = self.edited_latent(edit)?;
+        let (table, latent, _, material) = self.edited(edit)?;
         let stem: String = material
             .name
             .chars()
@@ -456,22 +515,35 @@ impl Editor {
         Ok(match what {
             Download::Binary => DownloadFile {
                 file_name: format!("{stem}-edited.binary"),
-                bytes: merl_bytes(self.decoded(&z)?.as_ref()),
+                bytes: merl_bytes(table.as_ref()),
             },
             Download::Bsdf => {
                 let file_name = format!("{stem}-edited.bsdf");
                 let name = format!("{} (edited)", material.name);
                 let resolution = deepbrdf_data::rgl::ExportResolution::default();
-                let table = self.decoded(&z)?;
                 let file = deepbrdf_data::rgl::export(&table, &name, &resolution, &file_name)
                     .map_err(internal)?;
                 DownloadFile { file_name, bytes: file.to_bytes() }
             }
-            Download::Latent => DownloadFile {
-                file_name: format!("{stem}-edited.json"),
-                bytes: LatentFile::new(self.model.id(), &format!("{} (edited)", material.name), z)
+            Download::Latent => {
+                let Some(z) = latent else {
+                    return Err(Refusal::BadRequest(format!(
+                        "the {} edit edits the table, not the latent: download the .binary or \
+                         .bsdf",
+                        edit.mode
+                    ))
+                    .into());
+                };
+                DownloadFile {
+                    file_name: format!("{stem}-edited.json"),
+                    bytes: LatentFile::new(
+                        self.model.id(),
+                        &format!("{} (edited)", material.name),
+                        z,
+                    )
                     .to_bytes()?,
-            },
+                }
+            }
         })
     }
 }

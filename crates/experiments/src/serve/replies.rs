@@ -56,8 +56,9 @@ pub struct Preview {
     pub quality: Quality,
     pub size: u32,
     pub spp: u32,
-    /// The latent of the edit (decoded to the previewed table).
-    pub latent: Vec<f32>,
+    /// The latent of the edit (decoded to the previewed table); none for the modes that edit
+    /// the table itself.
+    pub latent: Option<Vec<f32>>,
     /// The attributes asked for.
     pub requested: AttributesJson,
     /// The attributes of the unedited (blended) material the edit starts from.
@@ -68,7 +69,7 @@ pub struct Preview {
     pub seconds: Seconds,
 }
 
-/// Seconds in the editor: regressor, decode (0 when cached), render, all.
+/// Seconds in the editor: regressor, decode or table edit (0 when cached), render, all.
 #[derive(Debug, Clone, Copy, Default, Serialize)]
 pub struct Seconds {
     pub regressor: f64,

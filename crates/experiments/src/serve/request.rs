@@ -160,7 +160,8 @@ impl SceneChoice {
     }
 }
 
-/// A second material blended with the first in the latent space: `(1 - t) z_a + t z_b`.
+/// A second material blended with the first: `(1 - t) z_a + t z_b` in the latent space for the
+/// latent modes, `(1 - t) A + t B` of the tables for the others.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BlendRequest {
@@ -217,14 +218,7 @@ impl EditRequest {
         };
         let mode = match self.mode.as_deref() {
             None => DEFAULT_LATENT_MODE,
-            Some(name) => match name.parse::<EditMode>().map_err(|e| bad(e.to_string()))? {
-                m if EditMode::LATENT.contains(&m) => m,
-                m => {
-                    return Err(bad(format!(
-                        "the editor edits latents: mode {m} is not one of them (paper, residual)"
-                    )))
-                }
-            },
+            Some(name) => name.parse::<EditMode>().map_err(|e| bad(e.to_string()))?,
         };
         let edit = Edit {
             diffuse: self.diffuse.map(ColourEdit::Set),
@@ -368,6 +362,8 @@ mod tests {
         r.blend = None;
         r.mode = Some("linear".into());
         assert!(r.check(&c).unwrap_err().message().contains("mode"));
+        r.mode = Some("stretch".into());
+        assert_eq!(r.check(&c).unwrap().mode, EditMode::Stretch);
         r.mode = None;
         for (scene, needle) in [
             (SceneChoice { shape: "cube".into(), ..SceneChoice::default() }, "shape"),
