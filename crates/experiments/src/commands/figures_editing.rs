@@ -87,7 +87,8 @@ struct Rep<'a> {
     space: Space<'a>,
 }
 
-/// A sweep of `edits` on one material for one representation and mode: its tables.
+/// A sweep of `edits` on one material for one representation and mode: its tables. The
+/// table is encoded only for a mode that edits its latent ([`EditMode::needs_latent`]).
 fn sweep(
     rep: &Rep,
     table: &MerlTable,
@@ -95,7 +96,10 @@ fn sweep(
     edits: &[Edit],
     mode: EditMode,
 ) -> anyhow::Result<Vec<MerlTable>> {
-    let latent = rep.space.codec.encode(table)?;
+    let latent = match mode.needs_latent() {
+        true => rep.space.codec.encode(table)?,
+        false => Vec::new(),
+    };
     edits.iter().map(|e| Ok(rep.space.edit(table, &latent, original, e, mode)?.table)).collect()
 }
 

@@ -18,7 +18,7 @@ use deepbrdf_model::{DeepBrdf, TrainConfig};
 use deepbrdf_render::sheet::{contact_sheet, SheetConfig, Tile};
 use deepbrdf_render::Tonemap;
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -50,7 +50,7 @@ fn spaced(n: usize, show: usize) -> Vec<usize> {
 
 /// A model and the label of its norm ("L2", "L1").
 fn load(
-    dir: &PathBuf,
+    dir: &Path,
     device: &deepbrdf_model::burn::tensor::Device,
 ) -> anyhow::Result<(DeepBrdf, String)> {
     let model = DeepBrdf::load(dir, device)?;

@@ -14,7 +14,7 @@
 use super::request::{
     check_upload_name, Catalogue, CheckedEdit, Quality, Refusal, UPLOAD_COLLECTION,
 };
-use crate::editing::{self, EditMode, ModelCodec, Space};
+use crate::editing;
 use crate::latent_file::LatentFile;
 use deepbrdf_data::cache::Cache;
 use deepbrdf_data::dataset::load_bundled_material;
@@ -32,6 +32,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::Instant;
 use tokio::sync::oneshot;
+
+mod plan;
 
 use super::queue::{Job, PreviewJob, Queue, Reply, Shared};
 use super::recent::Recent;
@@ -59,7 +61,7 @@ const PREVIEW_SEED: u64 = 0x5eed;
 /// Materials kept open (each ~40 MB: its table, the interleaved copy, its sampler).
 const OPEN_MATERIALS: usize = 8;
 /// Decoded tables kept (17.5 MB each), by latent; as many edited tables of the modes that
-/// edit the table itself, by edit.
+/// edit the table itself, by edit ([`plan`]).
 const DECODED_TABLES: usize = 4;
 /// Renders of originals kept (PNG bytes), by material and scene.
 const ORIGINAL_RENDERS: usize = 32;
@@ -349,90 +351,6 @@ impl Editor {
         Ok(png)
     }
 
-    /// The latent, attributes and sampler the edit starts from: the material's, or the latent
-    /// blend of two materials with the blend of their attributes.
-    fn base(
-        &mut self,
-        edit: &CheckedEdit,
-    ) -> Result<(Vec<f32>, Attributes, Arc<Material>), Failure> {
-        let a = self.material(&edit.material)?;
-        let Some((other, t)) = &edit.blend else {
-            return Ok((a.latent.clone(), a.attributes, a));
-        };
-        let b = self.material(other)?;
-        let attributes = a.attributes.blend(&b.attributes, *t);
-        Ok((editing::blend(&a.latent, &b.latent, *t), attributes, a))
-    }
-
-    /// The edit's latent and the attributes asked for.
-    fn edited_latent(
-        &mut self,
-        edit: &CheckedEdit,
-    ) -> Result<(Vec<f32>, Attributes, Attributes, Arc<Material>), Failure> {
-        let (latent, base, material) = self.base(edit)?;
-        let requested = edit.edit.apply(&base).map_err(|e| Refusal::BadRequest(e.to_string()))?;
-        let codec = ModelCodec(&self.model);
-        let space = Space { codec: &codec, regressor: &self.regressor };
-        let z = space.edited_latent(&latent, &base, &requested, edit.mode)?;
-        Ok((z, requested, base, material))
-    }
-
-    /// The edited table of a mode that edits the table itself (transfer, analytic, stretch;
-    /// [`Space::edit`]), from the material's table or the linear blend of the two materials'
-    /// tables, with the attributes asked for; kept for the next request with the same edit.
-    fn edited_table(
-        &mut self,
-        edit: &CheckedEdit,
-    ) -> Result<(Arc<MerlTable>, Attributes, Attributes, Arc<Material>), Failure> {
-        let (latent, base, material) = self.base(edit)?;
-        let requested = edit.edit.apply(&base).map_err(|e| Refusal::BadRequest(e.to_string()))?;
-        let key = format!("{:?}", (&edit.material, &edit.blend, edit.mode.name(), &edit.edit));
-        if let Some(t) = self.edited.get(&key) {
-            return Ok((t, requested, base, material));
-        }
-        let blended = match &edit.blend {
-            None => None,
-            Some((other, t)) => {
-                let b = self.material(other)?;
-                Some(editing::blend_tables(&material.table, &b.table, *t)?)
-            }
-        };
-        let codec = ModelCodec(&self.model);
-        let space = Space { codec: &codec, regressor: &self.regressor };
-        let table = blended.as_ref().unwrap_or(&material.table);
-        let edited = space.edit(table, &latent, &base, &edit.edit, edit.mode)?;
-        let table = Arc::new(edited.table);
-        self.edited.put(key, table.clone());
-        Ok((table, requested, base, material))
-    }
-
-    /// The edited table and, for a mode that edits the latent (paper, residual), the latent,
-    /// with the attributes asked for and the base.
-    #[allow(clippy::type_complexity)]
-    fn edited(
-        &mut self,
-        edit: &CheckedEdit,
-    ) -> Result<(Arc<MerlTable>, Option<Vec<f32>>, Attributes, Arc<Material>), Failure> {
-        if EditMode::LATENT.contains(&edit.mode) {
-            let (z, requested, _, material) = self.edited_latent(edit)?;
-            return Ok((self.decoded(&z)?, Some(z), requested, material));
-        }
-        let (table, requested, _, material) = self.edited_table(edit)?;
-        Ok((table, None, requested, material))
-    }
-
-    /// The decoded table of a latent (kept for the next request with the same latent: the
-    /// refined preview, a download).
-    fn decoded(&mut self, z: &[f32]) -> Result<Arc<MerlTable>, Failure> {
-        let key: Vec<u32> = z.iter().map(|v| v.to_bits()).collect();
-        if let Some(t) = self.decoded.get(&key) {
-            return Ok(t);
-        }
-        let table = Arc::new(self.model.decode(z).map_err(internal)?);
-        self.decoded.put(key, table.clone());
-        Ok(table)
-    }
-
     fn current(&self, generation: u64) -> Result<(), Failure> {
         match self.shared.latest.load(Ordering::SeqCst) == generation {
             true => Ok(()),
@@ -449,26 +367,15 @@ impl Editor {
         let t0 = Instant::now();
         let scene = self.scene(&edit.scene)?;
         // The regressor, then the decoder; a mode that edits the table counts as a decode.
-        let (latent, requested, base, material, table, t1) =
-            match EditMode::LATENT.contains(&edit.mode) {
-                true => {
-                    let (z, requested, base, material) = self.edited_latent(edit)?;
-                    let t1 = Instant::now();
-                    self.current(generation)?;
-                    let table = self.decoded(&z)?;
-                    (Some(z), requested, base, material, table, t1)
-                }
-                false => {
-                    let t1 = Instant::now();
-                    let (table, requested, base, material) = self.edited_table(edit)?;
-                    (None, requested, base, material, table, t1)
-                }
-            };
+        let plan = self.plan(edit)?;
+        let t1 = Instant::now();
+        self.current(generation)?;
+        let table = self.table(edit, &plan)?;
         let t2 = Instant::now();
         self.current(generation)?;
         let (image, settings, achieved) = match quality {
             Quality::Fast => {
-                let brdf = MerlBrdf::new_sampled(&table, material.sampling.clone());
+                let brdf = MerlBrdf::new_sampled(&table, plan.material.sampling.clone());
                 (render(&scene, &brdf, &FAST, &Silent).map_err(internal)?, FAST, None)
             }
             Quality::Refined => {
@@ -492,9 +399,9 @@ impl Editor {
             quality,
             size: settings.size,
             spp: settings.spp,
-            latent,
-            requested: (&requested).into(),
-            base: (&base).into(),
+            latent: plan.latent,
+            requested: (&plan.requested).into(),
+            base: (&plan.base).into(),
             achieved,
             seconds: Seconds {
                 regressor: (t1 - t0).as_secs_f64(),
@@ -506,7 +413,8 @@ impl Editor {
     }
 
     fn download(&mut self, edit: &CheckedEdit, what: Download) -> Result<DownloadFile, Failure> {
-        let (table, latent, _, material) = self.edited(edit)?;
+        let plan = self.plan(edit)?;
+        let material = plan.material.clone();
         let stem: String = material
             .name
             .chars()
@@ -515,18 +423,19 @@ impl Editor {
         Ok(match what {
             Download::Binary => DownloadFile {
                 file_name: format!("{stem}-edited.binary"),
-                bytes: merl_bytes(table.as_ref()),
+                bytes: merl_bytes(self.table(edit, &plan)?.as_ref()),
             },
             Download::Bsdf => {
                 let file_name = format!("{stem}-edited.bsdf");
                 let name = format!("{} (edited)", material.name);
                 let resolution = deepbrdf_data::rgl::ExportResolution::default();
+                let table = self.table(edit, &plan)?;
                 let file = deepbrdf_data::rgl::export(&table, &name, &resolution, &file_name)
                     .map_err(internal)?;
                 DownloadFile { file_name, bytes: file.to_bytes() }
             }
             Download::Latent => {
-                let Some(z) = latent else {
+                let Some(z) = plan.latent else {
                     return Err(Refusal::BadRequest(format!(
                         "the {} edit edits the table, not the latent: download the .binary or \
                          .bsdf",
