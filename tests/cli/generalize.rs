@@ -1,5 +1,6 @@
-//! `figures-generalize` (Fig. 9) and `figures-loss` (Fig. 4) on tiny data: a model and IPCA fitted on three synthetic
-//! materials, shown on two others; a model of other data without `--ipca-data` is refused.
+//! `figures-generalize` (Fig. 9) and `figures-loss` (Fig. 4) on tiny data: models (and IPCA)
+//! fitted on three synthetic materials, shown on two others; a model of other data without
+//! `--ipca-data` is refused.
 use crate::util;
 use crate::util::s;
 
