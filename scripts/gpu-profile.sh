@@ -9,8 +9,9 @@
 # default 32) with CubeCL's kernel profiler on (CUBECL_DEBUG_OPTION=profile), its log
 # compressed to OUT/cubecl-profile.log.gz and summed per kernel in OUT/profile-summary.txt
 # (scripts/cubecl-profile-summary.py); and PyTorch's Table 1 on the same GPU in strict
-# f32 (TF32 off for convolutions and matrix products), beside its default (TF32 on), in
-# OUT/torch-f32.txt.
+# f32 (TF32 off for convolutions and matrix products) and its default (TF32 on), in
+# OUT/torch-f32.txt (scripts/torch-bench.py). CONV (default gemm) picks how Burn computes the
+# convolutions.
 set -uo pipefail
 bundle="$(realpath "$1")"
 out="$(realpath -m "$2")"
@@ -34,19 +35,11 @@ fi
 
 echo "== Burn, $preset, batch $batch, CubeCL profiler on"
 CUBECL_DEBUG_LOG=/tmp/cubecl-profile.log CUBECL_DEBUG_OPTION=profile \
-    timeout 150 "$bin" --device wgpu bench model --preset "$preset" --batch "$batch" --steps 2 --decodes 2
+    timeout 150 "$bin" --device wgpu bench model --preset "$preset" --batch "$batch" --steps 2 --decodes 2 \
+        --conv "${CONV:-gemm}"
 gzip -c /tmp/cubecl-profile.log >"$out/cubecl-profile.log.gz"
 python3 scripts/cubecl-profile-summary.py /tmp/cubecl-profile.log | tee "$out/profile-summary.txt"
 
 if [[ -f "$bundle/torch_table1.py" ]]; then
-    echo "== PyTorch, batch 1,$batch, strict f32 (TF32 off)"
-    timeout 90 python3 - "$bundle/torch_table1.py" "$batch" <<'EOF' 2>&1 | tee "$out/torch-f32.txt"
-import runpy, sys, torch
-torch.backends.cudnn.allow_tf32 = False
-torch.backends.cuda.matmul.allow_tf32 = False
-script, batch = sys.argv[1], sys.argv[2]
-for mode in (["--mode", "train", "--batch", f"1,{batch}", "--steps", "12"], ["--mode", "decode", "--steps", "20"]):
-    sys.argv = [script, "--device", "cuda", *mode]
-    runpy.run_path(script, run_name="__main__")
-EOF
+    timeout 150 python3 scripts/torch-bench.py "$bundle/torch_table1.py" "1,$batch" 2>&1 | tee "$out/torch-f32.txt"
 fi

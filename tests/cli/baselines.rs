@@ -83,6 +83,7 @@ fn baselines_in_sample_writes_results_and_bases_and_protects_them() {
         mode: Mode::InSample,
         seed: 0,
         measures: vec![Measure::MappedMse, Measure::CosRmse],
+        only_fold: None,
     };
     let (pca, ipca) = (BaselineMethod::pca(), BaselineMethod::ipca());
     let methods: [&dyn Method; 2] = [&pca, &ipca];
@@ -201,4 +202,24 @@ fn folds_lists_the_materials_each_fold_of_baselines_scores() {
     assert!(!fold1.is_empty() && fold1.iter().all(|l| scored.contains(l)), "{fold1:?}");
     let out = util::run_in(dir.path(), &["folds", "--mode", "kfold:3", "--fold", "3", "--data", d]);
     util::assert_clean_failure(&out, "folds 0 to 2");
+    // `baselines --fold 1` scores exactly those materials, fitted once.
+    let one = ["baselines", "--mode", "kfold:3", "--k", "1", "--methods", "pca", "--measures"];
+    let mut args = one.to_vec();
+    args.extend(["mapped_mse", "--data", d, "--out", "res1", "--fold", "1"]);
+    let out = util::run_in(dir.path(), &args);
+    assert!(out.status.success(), "{}", util::stderr(&out));
+    let csv = std::fs::read_to_string(dir.path().join("res1").join("results.csv")).unwrap();
+    let mut only: Vec<String> =
+        csv.lines().skip(1).map(|l| l.split(',').collect::<Vec<_>>()[2..4].join("\t")).collect();
+    only.sort();
+    let mut fold1 = fold1;
+    fold1.sort();
+    assert_eq!(only, fold1);
+    let summary = std::fs::read_to_string(dir.path().join("res1").join("summary.md")).unwrap();
+    assert!(summary.contains("fold 1 only"), "{summary}");
+    let mut args = one.to_vec();
+    args.extend(["mapped_mse", "--data", d, "--out", "res3", "--fold", "3"]);
+    util::assert_clean_failure(&util::run_in(dir.path(), &args), "fold 3 does not exist");
+    let out = util::run_in(dir.path(), &["baselines", "--k", "1", "--data", d, "--fold", "0"]);
+    util::assert_clean_failure(&out, "kfold mode only");
 }

@@ -187,6 +187,66 @@ fn bench_model_prints_the_decode_time_next_to_ipcas() {
 }
 
 #[test]
+fn bench_model_times_both_convolution_algorithms_of_a_convolutional_network() {
+    use deepbrdf_model::autoencoder::ConvolutionalConfig;
+    use deepbrdf_model::AutoencoderConfig;
+    let dir = tempfile::tempdir().unwrap();
+    let layers = ConvolutionalConfig::new()
+        .with_projection(Some(2))
+        .with_encoder_channels([2, 2, 2])
+        .with_residual_blocks(1)
+        .with_decoder_channels([2, 2]);
+    let config = TrainConfig::new(
+        AutoencoderConfig::convolutional(2, layers),
+        deepbrdf_model::burn::optim::AdamConfig::new(),
+    )
+    .with_batch_size(1);
+    let path = dir.path().join("narrow.json");
+    config.save(&path).unwrap();
+    let path = path.to_str().unwrap();
+    let out = util::run(&[
+        "bench",
+        "model",
+        "--config",
+        path,
+        "--conv",
+        "direct,gemm",
+        "--steps",
+        "1",
+        "--decodes",
+        "1",
+    ]);
+    assert!(out.status.success(), "{}", util::stderr(&out));
+    let text = util::stdout(&out);
+    for row in ["config/direct", "config/gemm", "config training step: direct / gemm = "] {
+        assert!(text.lines().any(|l| l.starts_with(row)), "no line {row:?}: {text}");
+    }
+    // The slice network has no convolutions: --conv leaves its row alone, train refuses it.
+    let out = util::run(&[
+        "bench",
+        "model",
+        "--preset",
+        "slice",
+        "--k",
+        "2",
+        "--conv",
+        "gemm",
+        "--steps",
+        "1",
+        "--decodes",
+        "1",
+    ]);
+    assert!(out.status.success(), "{}", util::stderr(&out));
+    assert!(util::stdout(&out).lines().any(|l| l.starts_with("slice ")), "{}", util::stdout(&out));
+    let out =
+        util::run_in(dir.path(), &["train", "--preset", "slice", "--conv", "gemm", "--out", "o"]);
+    util::assert_clean_failure(&out, "no convolutions");
+    let out =
+        util::run_in(dir.path(), &["train", "--preset", "paper", "--conv", "fft", "--out", "o"]);
+    util::assert_clean_failure(&out, "expected gemm or direct");
+}
+
+#[test]
 fn the_configurations_in_configs_load_and_differ_from_the_slice_preset_only_in_its_network() {
     use deepbrdf_model::TrainConfig;
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs");

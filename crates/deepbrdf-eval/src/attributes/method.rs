@@ -86,6 +86,7 @@ mod tests {
             mode: Mode::InSample,
             seed: 0,
             measures: vec![Measure::CosRmse],
+            only_fold: None,
         };
         let results = harness::run(&[&method], &config, data, None, &Silent).unwrap();
         // Tables of the model itself are reproduced up to the fit's and f32's precision.

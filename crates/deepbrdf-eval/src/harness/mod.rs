@@ -33,6 +33,9 @@ pub struct HarnessConfig {
     /// Seed of the k-fold split.
     pub seed: u64,
     pub measures: Vec<Measure>,
+    /// In k-fold mode, score only this fold (its held-out materials, with a codec fitted on
+    /// the others): one held-out experiment at the cost of one training.
+    pub only_fold: Option<usize>,
 }
 
 impl HarnessConfig {
@@ -55,6 +58,21 @@ impl HarnessConfig {
         measures.dedup();
         if measures.len() != self.measures.len() {
             return Err(EvalError::Invalid(format!("repeated measure in {:?}", self.measures)));
+        }
+        match (self.only_fold, self.mode) {
+            (None, _) => {}
+            (Some(f), Mode::KFold { folds }) if f >= folds => {
+                return Err(EvalError::Invalid(format!(
+                    "fold {f} does not exist: kfold:{folds} has folds 0 to {}",
+                    folds - 1
+                )))
+            }
+            (Some(_), Mode::KFold { .. }) => {}
+            (Some(_), mode) => {
+                return Err(EvalError::Invalid(format!(
+                    "one fold can be chosen in kfold mode only, not in {mode} mode"
+                )))
+            }
         }
         Ok(())
     }
@@ -165,6 +183,9 @@ pub fn run_with_extra(
     }
     let started = Instant::now();
     let mut folds = config.mode.folds(scored, eval_set.tables.len(), config.seed)?;
+    if let Some(only) = config.only_fold {
+        folds.retain(|f| f.index == only);
+    }
     for fold in &mut folds {
         fold.train.extend(scored..train.tables.len());
     }
@@ -280,7 +301,12 @@ pub fn run_with_extra(
         methods: methods.iter().map(|m| m.name()).collect(),
         measures: config.measures.clone(),
         train_label,
-        eval_label: eval_set.label.to_string(),
+        eval_label: match (config.only_fold, folds.first()) {
+            (Some(f), Some(fold)) => {
+                format!("{}, fold {f} only ({} scored)", eval_set.label, fold.test.len())
+            }
+            _ => eval_set.label.to_string(),
+        },
         records,
         fits,
         eval_seconds,

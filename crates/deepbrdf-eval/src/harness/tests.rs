@@ -18,6 +18,7 @@ fn image_relae_is_measured_on_renders_and_vanishes_for_an_exact_reconstruction()
         mode: Mode::InSample,
         seed: 1,
         measures: vec![Measure::ImageRelae, Measure::MappedMse],
+        only_fold: None,
     };
     let data = Materials { names: &names, tables: &tables, label: "synthetic" };
     let results = run(&[&pca], &config, data, None, &Silent).unwrap();
@@ -42,6 +43,7 @@ fn in_sample_error_falls_with_k_and_vanishes_at_n_minus_1() {
         mode: Mode::InSample,
         seed: 1,
         measures: Measure::TABLE.to_vec(),
+        only_fold: None,
     };
     let data = Materials { names: &names, tables: &tables, label: "synthetic" };
     let results = run(&[&pca, &ipca], &config, data, None, &Silent).unwrap();
@@ -86,6 +88,7 @@ fn a_method_restricted_to_some_k_is_fitted_and_scored_only_there() {
         mode: Mode::KFold { folds: 3 },
         seed: 3,
         measures: vec![Measure::MappedMse],
+        only_fold: None,
     };
     let data = Materials { names: &names, tables: &tables, label: "synthetic" };
     let only_2 = AtKs::new(&ipca, &[2, 7]);
@@ -160,6 +163,7 @@ fn kfold3() -> HarnessConfig {
         mode: Mode::KFold { folds: 3 },
         seed: 5,
         measures: vec![Measure::MappedMse],
+        only_fold: None,
     }
 }
 
@@ -186,6 +190,31 @@ fn kfold_never_evaluates_a_material_it_was_fitted_on() {
     }
     // The same spy fails in-sample mode, which is the point of the check.
     let in_sample = HarnessConfig { mode: Mode::InSample, ..config };
+    assert!(run(&[&spy], &in_sample, data, None, &Silent).is_err());
+}
+
+#[test]
+fn one_fold_alone_is_trained_once_and_scores_only_its_held_out_materials() {
+    let (names, tables) = sparse_set(7);
+    let data = Materials { names: &names, tables: &tables, label: "synthetic" };
+    let all =
+        run(&[&Spy { fitted: Mutex::new(Vec::new()) }], &kfold3(), data, None, &Silent).unwrap();
+    let spy = Spy { fitted: Mutex::new(Vec::new()) };
+    let config = HarnessConfig { only_fold: Some(1), ..kfold3() };
+    let results = run(&[&spy], &config, data, None, &Silent).unwrap();
+    let fold1: Vec<&str> =
+        all.records.iter().filter(|r| r.fold == 1).map(|r| r.material.as_str()).collect();
+    let scored: Vec<&str> = results.records.iter().map(|r| r.material.as_str()).collect();
+    assert!(!fold1.is_empty());
+    assert_eq!(scored, fold1);
+    assert!(results.records.iter().all(|r| r.fold == 1));
+    assert_eq!(spy.fitted.lock().unwrap().len(), 1);
+    assert!(results.eval_label.contains("fold 1 only"), "{}", results.eval_label);
+    // A fold that does not exist, and a fold outside k-fold mode, are refused.
+    let missing = HarnessConfig { only_fold: Some(3), ..kfold3() };
+    let err = run(&[&spy], &missing, data, None, &Silent).unwrap_err().to_string();
+    assert!(err.contains("fold 3 does not exist"), "{err}");
+    let in_sample = HarnessConfig { mode: Mode::InSample, only_fold: Some(0), ..kfold3() };
     assert!(run(&[&spy], &in_sample, data, None, &Silent).is_err());
 }
 
@@ -230,6 +259,7 @@ fn generalize_fits_on_one_set_and_evaluates_another() {
         mode: Mode::Generalize,
         seed: 0,
         measures: vec![Measure::MappedMse],
+        only_fold: None,
     };
     let (first, last) = (tables[..5].to_vec(), tables[5..].to_vec());
     let train = Materials { names: &names[..5], tables: &first, label: "first five" };

@@ -6,7 +6,7 @@
 use burn::config::Config;
 use serde::{Deserialize, Serialize};
 
-use super::convolutional::ConvolutionalConfig;
+use super::convolutional::{ConvAlgorithm, ConvolutionalConfig};
 use super::limits::MAX_WIDTH;
 use super::retired;
 use super::slice::SliceConfig;
@@ -78,6 +78,20 @@ impl AutoencoderConfig {
         match &self.architecture {
             Architecture::Slice(s) => Some(s),
             _ => None,
+        }
+    }
+
+    /// Computes the convolutions with `conv` (the same parameters and values); an error for a
+    /// network without convolutions.
+    pub fn set_conv(&mut self, conv: ConvAlgorithm) -> crate::error::Result<()> {
+        match &mut self.architecture {
+            Architecture::Convolutional(layers) => {
+                layers.conv = conv;
+                Ok(())
+            }
+            Architecture::Slice(_) => Err(ModelError::Invalid(
+                "the slice network has no convolutions to compute another way".into(),
+            )),
         }
     }
 

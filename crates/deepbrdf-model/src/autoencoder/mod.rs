@@ -26,7 +26,7 @@ use deepbrdf_data::layout::{SIDE, SLICE_CHANNELS};
 use deepbrdf_data::merl::VALUES;
 
 pub use config::{Architecture, AutoencoderConfig, NEGATIVE_SLOPE};
-pub use convolutional::{Convolutional, ConvolutionalConfig, BOTTLENECK_SIDE};
+pub use convolutional::{ConvAlgorithm, Convolutional, ConvolutionalConfig, BOTTLENECK_SIDE};
 pub(crate) use retired::{message as retired_message, retired_network};
 pub use slice::{SliceConfig, SliceNetwork, SLICE_DIRECTIONS};
 

@@ -32,6 +32,10 @@ pub struct Args {
     /// Seed of the k-fold split.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// kfold mode: score only this fold's held-out materials (one training; `experiments folds
+    /// --fold F` lists them).
+    #[arg(long, value_name = "F")]
+    pub fold: Option<usize>,
     /// Error measures (comma-separated): mapped_mse (eq. 1 space), cos_rmse, image_relae
     /// (renders the original and each reconstruction: ~0.3 s of CPU per pair).
     #[arg(long, value_delimiter = ',', default_value = "mapped_mse,cos_rmse")]
@@ -84,6 +88,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         mode: args.mode,
         seed: args.seed,
         measures: args.measures.clone(),
+        only_fold: args.fold,
     };
     config.validate()?;
     if args.save_basis.is_some() && matches!(args.mode, Mode::KFold { .. }) {

@@ -184,6 +184,7 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
         mode: args.mode,
         seed: args.seed,
         measures: args.measures.clone(),
+        only_fold: None,
     };
     harness_config.validate()?;
     let config_for = args.config_for()?;

@@ -10,7 +10,7 @@ use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::lock::FolderLock;
 use deepbrdf_data::Progress;
-use deepbrdf_model::autoencoder::Architecture;
+use deepbrdf_model::autoencoder::{Architecture, ConvAlgorithm};
 use deepbrdf_model::loss::LossNorm;
 use deepbrdf_model::train::{checkpoint_path, saved_config};
 use deepbrdf_model::{fit, Preset, SliceDropoutConfig, TrainConfig};
@@ -59,6 +59,11 @@ pub struct Args {
     /// preset's or file's, l2].
     #[arg(long, value_name = "NORM", value_parser = parse_norm)]
     pub loss: Option<LossNorm>,
+    /// How a convolutional network computes its convolutions: gemm (as matrix products) or
+    /// direct (Burn's modules); the same parameters and values either way [default: the
+    /// preset's or file's, gemm].
+    #[arg(long, value_name = "ALGORITHM")]
+    pub conv: Option<ConvAlgorithm>,
     /// Output directory (checkpoint, log, configuration, and the model in DIR/model).
     #[arg(long, value_name = "DIR", required_unless_present = "resume")]
     pub out: Option<PathBuf>,
@@ -123,6 +128,9 @@ impl Args {
         }
         if let Some(norm) = self.loss {
             config.loss_norm = Some(norm);
+        }
+        if let Some(conv) = self.conv {
+            config.model.set_conv(conv).context("--conv")?;
         }
         if let Some(passes) = self.held_passes {
             match &mut config.model.architecture {

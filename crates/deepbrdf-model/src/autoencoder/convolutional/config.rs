@@ -1,6 +1,7 @@
 //! The layers of Table 1's convolutional network and the checks of their sizes.
 
 use burn::config::Config;
+use serde::{Deserialize, Serialize};
 
 use crate::autoencoder::limits::MAX_WIDTH;
 use crate::error::ModelError;
@@ -31,6 +32,33 @@ pub struct ConvolutionalConfig {
     /// latent vector starts near zero. Not a Table 1 setting; training converges much faster.
     #[config(default = false)]
     pub he_init: bool,
+    /// How the convolutions are computed: the same parameters and values either way (within
+    /// f32 rounding), so a model saved with one loads and runs with the other.
+    #[config(default = "ConvAlgorithm::Gemm")]
+    pub conv: ConvAlgorithm,
+}
+
+/// How Table 1's convolutions and transposed convolutions are computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ConvAlgorithm {
+    /// Burn's `Conv2d` and `ConvTranspose2d` modules as they are (on its GPU backends without
+    /// kernel autotuning: a direct convolution kernel for every pass).
+    Direct,
+    /// As matrix products ([`super::gemm`]): shifted slices stacked into columns, one batched
+    /// product per layer; the transposed convolutions by their sub-pixel phases.
+    Gemm,
+}
+
+deepbrdf_data::named_enum!(ConvAlgorithm { Direct => "direct", Gemm => "gemm" });
+
+impl std::str::FromStr for ConvAlgorithm {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::from_name(s)
+            .ok_or_else(|| format!("unknown convolution algorithm '{s}': expected gemm or direct"))
+    }
 }
 
 impl ConvolutionalConfig {

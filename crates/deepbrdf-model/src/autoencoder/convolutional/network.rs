@@ -14,7 +14,7 @@ use burn::tensor::Distribution;
 
 use deepbrdf_data::layout::{SIDE as INPUT_SIDE, SLICE_CHANNELS as INPUT_CHANNELS};
 
-use super::config::ConvolutionalConfig;
+use super::config::{ConvAlgorithm, ConvolutionalConfig};
 use crate::autoencoder::init::initializers;
 
 /// Side of the bottleneck images after three stride-2 convolutions (90 -> 45 -> 23 -> 12).
@@ -41,6 +41,10 @@ pub struct Convolutional {
     bottleneck_channels: usize,
     pub(crate) latent: usize,
     negative_slope: f64,
+    /// How the convolutions are computed (not a parameter: set by the configuration, or
+    /// [`Convolutional::with_conv`]).
+    #[module(skip)]
+    conv: ConvAlgorithm,
 }
 
 impl Convolutional {
@@ -110,7 +114,18 @@ impl Convolutional {
             bottleneck_channels: e2,
             latent,
             negative_slope,
+            conv: layers.conv,
         }
+    }
+
+    /// The same network computing its convolutions with `conv`.
+    pub fn with_conv(self, conv: ConvAlgorithm) -> Self {
+        Self { conv, ..self }
+    }
+
+    /// How the network computes its convolutions.
+    pub fn conv(&self) -> ConvAlgorithm {
+        self.conv
     }
 
     /// Encoder f (eq. 2) on centred, masked inputs.
@@ -125,10 +140,10 @@ impl Convolutional {
             None => centred, // [batch, 540, 90, 90]
         };
         for conv in &self.down {
-            x = leaky_relu(conv.forward(x), slope); // [batch, e0, 45, 45], [batch, e1, 23, 23], [batch, e2, 12, 12]
+            x = leaky_relu(self.conv.conv2d(conv, x), slope); // [batch, e0, 45, 45], [batch, e1, 23, 23], [batch, e2, 12, 12]
         }
         for block in &self.residual {
-            x = block.forward(x, slope); // [batch, e2, 12, 12]
+            x = block.forward(x, slope, self.conv); // [batch, e2, 12, 12]
         }
         let x = x.reshape([batch, self.bottleneck_channels * BOTTLENECK_SIDE * BOTTLENECK_SIDE]); // [batch, e2*144]
         self.to_latent.forward(x) // [batch, k]
@@ -145,7 +160,7 @@ impl Convolutional {
         let mut y = y.reshape([batch, self.bottleneck_channels, BOTTLENECK_SIDE, BOTTLENECK_SIDE]); // [batch, e2, 12, 12]
         let last = self.up.len().saturating_sub(1);
         for (i, deconv) in self.up.iter().enumerate() {
-            y = deconv.forward(y); // [batch, d0, 24, 24], [batch, d1, 48, 48], [batch, C or 540, 90, 90]
+            y = self.conv.conv_transpose2d(deconv, y); // [batch, d0, 24, 24], [batch, d1, 48, 48], [batch, C or 540, 90, 90]
             if i < last {
                 y = leaky_relu(y, slope);
             }
@@ -184,9 +199,9 @@ impl ResidualBlock {
     ///
     /// # Shapes
     /// - x: `[batch, c, 12, 12]` -> `[batch, c, 12, 12]`
-    fn forward(&self, x: Tensor<4>, slope: f64) -> Tensor<4> {
-        let y = leaky_relu(self.conv1.forward(x.clone()), slope); // [batch, c, 12, 12]
-        leaky_relu(x + self.conv2.forward(y), slope) // [batch, c, 12, 12]
+    fn forward(&self, x: Tensor<4>, slope: f64, conv: ConvAlgorithm) -> Tensor<4> {
+        let y = leaky_relu(conv.conv2d(&self.conv1, x.clone()), slope); // [batch, c, 12, 12]
+        leaky_relu(x + conv.conv2d(&self.conv2, y), slope) // [batch, c, 12, 12]
     }
 }
 

@@ -6,6 +6,7 @@
 use deepbrdf_data::testing::synthetic_set;
 use deepbrdf_data::{MerlTable, Progress, Silent};
 use deepbrdf_eval::baseline::{BaselineBasis, MappingKind};
+use deepbrdf_model::autoencoder::ConvAlgorithm;
 use deepbrdf_model::timing::{self, Timing};
 use deepbrdf_model::{Preset, TrainConfig};
 
@@ -26,6 +27,10 @@ pub struct Args {
     /// Timed decodes per preset (after one warm-up).
     #[arg(long, default_value_t = 5)]
     pub decodes: usize,
+    /// How the convolutional network computes its convolutions: gemm, direct, or both, one row
+    /// each (comma-separated) [default: the configuration's, gemm].
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    pub conv: Vec<ConvAlgorithm>,
     /// Also time the network of this training configuration (JSON, as `train` saves it).
     #[arg(long, value_name = "FILE")]
     pub config: Option<std::path::PathBuf>,
@@ -49,10 +54,13 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         let config = TrainConfig::from_file(path)?;
         runs.push(("config".to_string(), config));
     }
+    if !args.conv.is_empty() {
+        runs = with_conv(runs, &args.conv)?;
+    }
     println!("device {kind}, k = {}", args.k);
     let ipca = ipca_decode(args.k, args.decodes)?;
     println!(
-        "{:7} {:>6} {:>16} {:>16} {:>14} {:>14}",
+        "{:12} {:>6} {:>16} {:>16} {:>14} {:>14}",
         "preset", "batch", "train s/step", "train s/sample", "decode net s", "decode all s"
     );
     let mut per_sample = Vec::new();
@@ -64,7 +72,7 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         let (net, all) = (&decode.network, &decode.whole);
         let step = train.median();
         println!(
-            "{:7} {:>6} {:>16.3} {:>16.4} {:>14.4} {:>14.4}",
+            "{:12} {:>6} {:>16.3} {:>16.4} {:>14.4} {:>14.4}",
             name,
             batch,
             step,
@@ -73,7 +81,7 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
             all.median()
         );
         println!(
-            "{:7} decode vs IPCA's at k = {}: {:.4} s vs {:.4} s ({:.2}x, same run)",
+            "{:12} decode vs IPCA's at k = {}: {:.4} s vs {:.4} s ({:.2}x, same run)",
             "",
             args.k,
             all.median(),
@@ -85,6 +93,12 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     if let [(a, ta), (b, tb)] = &per_sample[..] {
         println!("training cost per sample: {b} / {a} = {:.1}x", tb / ta);
     }
+    for (name, step) in &per_sample {
+        let Some(base) = name.strip_suffix("/gemm") else { continue };
+        if let Some((_, direct)) = per_sample.iter().find(|(n, _)| *n == format!("{base}/direct")) {
+            println!("{base} training step: direct / gemm = {:.2}x (same run)", direct / step);
+        }
+    }
     println!("(medians; decode = network + inverse layout + inverse eq. (1) to a full MERL table)");
     println!(
         "IPCA decode at k = {}: {:.4} s (k coefficients -> the basis' row -> the inverse \
@@ -93,6 +107,27 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         ipca.median()
     );
     Ok(())
+}
+
+/// Each convolutional run once per algorithm of `conv`, named `NAME/ALGORITHM`; the others
+/// (the slice network has no convolutions) once.
+fn with_conv(
+    runs: Vec<(String, TrainConfig)>,
+    conv: &[ConvAlgorithm],
+) -> anyhow::Result<Vec<(String, TrainConfig)>> {
+    let mut out = Vec::new();
+    for (name, config) in runs {
+        if config.model.slice_config().is_some() {
+            out.push((name, config));
+            continue;
+        }
+        for &algorithm in conv {
+            let mut config = config.clone();
+            config.model.set_conv(algorithm)?;
+            out.push((format!("{name}/{algorithm}"), config));
+        }
+    }
+    Ok(out)
 }
 
 /// Times IPCA's decode of `k` coefficients into a full MERL table (`repeats` runs after a
