@@ -9,8 +9,7 @@ fn corpus_training_and_known_answer_edits() {
     let dir = tempfile::tempdir().unwrap();
     let data = util::write_data(dir.path(), 3);
     let ok = |args: &[&str]| {
-        let out = util::run_in(dir.path(), args);
-        assert!(out.status.success(), "{args:?}: {}", util::stderr(&out));
+        let out = util::run_ok(dir.path(), args);
         (util::stdout(&out), util::stderr(&out))
     };
     let corpus = dir.path().join("corpus");

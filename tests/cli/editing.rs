@@ -12,11 +12,7 @@ use crate::util::s;
 fn train_a_regressor_edit_and_interpolate() {
     let dir = tempfile::tempdir().unwrap();
     let data = util::write_data(dir.path(), 3);
-    let ok = |args: &[&str]| {
-        let out = util::run_in(dir.path(), args);
-        assert!(out.status.success(), "{args:?}: {}", util::stderr(&out));
-        util::stdout(&out)
-    };
+    let ok = |args: &[&str]| util::stdout(&util::run_ok(dir.path(), args));
     let mut runs = Vec::new();
     for seed in [0u64, 1] {
         let config = util::tiny_train_config().with_seed(seed);

@@ -1,5 +1,5 @@
 //! Single-image recovery end to end on tiny data: `render-set` (a few 16-px images of three
-//! synthetic materials; resumed; a held-out fold), `train-recovery` (the cpu CNN for two
+//! synthetic materials; resumed; a held-out fold), `train-recovery` (the small CNN for two
 //! epochs on a tiny `slice` model), `recover` (a set image and unusable photos) and the
 //! refusal of a network trained for another model.
 use crate::util;
@@ -12,11 +12,7 @@ use crate::util::s;
 fn render_set_train_recovery_and_recover_chain() {
     let dir = tempfile::tempdir().unwrap();
     let data = util::write_data(dir.path(), 3);
-    let ok = |args: &[&str]| {
-        let out = util::run_in(dir.path(), args);
-        assert!(out.status.success(), "{args:?}: {}", util::stderr(&out));
-        out
-    };
+    let ok = |args: &[&str]| util::run_ok(dir.path(), args);
     // A tiny `slice` model (k = 2) on the three materials.
     let config_path = util::tiny_config(dir.path());
     let model = dir.path().join("model");

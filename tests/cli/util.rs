@@ -57,6 +57,13 @@ pub fn run_in(cwd: &Path, args: &[&str]) -> Output {
         .expect("failed to spawn the experiments binary")
 }
 
+/// [`run_in`], asserting that the run succeeded (the arguments and stderr in the message).
+pub fn run_ok(cwd: &Path, args: &[&str]) -> Output {
+    let out = run_in(cwd, args);
+    assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+    out
+}
+
 /// Runs `experiments` with `args` in `cwd` (quiet) on `threads` rayon threads.
 pub fn run_on_threads(cwd: &Path, args: &[&str], threads: usize) -> Output {
     Command::new(env!("CARGO_BIN_EXE_experiments"))

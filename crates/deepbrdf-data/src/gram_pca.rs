@@ -1,5 +1,5 @@
 //! The Gram route of PCA (eq. 5 of Hu et al. 2020, `A - mu = U Sigma V^T`), shared by the PCA and
-//! IPCA baselines (`deepbrdf-eval`) and the basis of the `cpu` preset (`deepbrdf-model`).
+//! IPCA baselines (`deepbrdf-eval`) and the slice network's basis (`deepbrdf-model`).
 //!
 //! With n centred rows of a large dimension d (4,374,000 for a MERL table) the `d x d` covariance
 //! is never formed: the `n x n` Gram matrix `G = (A - mu)(A - mu)^T` is accumulated in f64 over

@@ -139,11 +139,8 @@ impl PixelSampler {
     /// on its own: the first light strategy (the sun) when there is one, else the BRDF's. A
     /// sharp lobe's image of the sun is about a pixel wide and its value depends on where in
     /// the pixel the sample falls *and* where in the sun's disk its light sample falls; with the
-    /// two in separate sets their interaction was sampled as by independent numbers. Measured
-    /// (`bench render-noise`'s measure, 256 px, 64 spp, sun and sky, 6 pairs of seeds, the
-    /// BRDF's pair in the position's set -> the sun's): cg_sunflower 0.157 ->
-    /// 0.077, chrome 3.93 -> 1.64, gold-metallic-paint 0.0158 -> 0.0168, blue-fabric 0.0109 ->
-    /// 0.0122 (the BRDF pair's joint stratification with the position helped those a little).
+    /// two in separate sets their interaction would be sampled as by independent numbers
+    /// (the noise this halves on sharp lobes: docs/performance.md).
     #[inline]
     pub fn shade_point(&mut self, index: u32, lights: usize) -> ShadePoint {
         match self {

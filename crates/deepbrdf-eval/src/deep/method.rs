@@ -70,8 +70,8 @@ pub struct DeepMethod {
     fits: Mutex<Vec<FitRecord>>,
     models: Mutex<Vec<(usize, usize, Arc<DeepBrdf>)>>,
     /// The k whose models stay in memory after their fold (all when `None`; the others are
-    /// loaded again by [`model`](Self::model)): a loaded `cpu` model holds a 0.67 GB basis, 20
-    /// of them do not fit in memory.
+    /// loaded again by [`model`](Self::model)), for models too large to keep one per fold and
+    /// k in memory.
     retained: Option<Vec<usize>>,
     /// How its models refine their encodings ([`deepbrdf_model::refine`]).
     refinement: Refinement,

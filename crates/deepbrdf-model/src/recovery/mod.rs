@@ -2,7 +2,7 @@
 //! to DeepBRDF's latent vector, and the frozen decoder turns that into a full MERL table.
 //!
 //! - [`network`]: the CNN (three convolutions, two max-poolings, two fully connected layers)
-//!   and its configuration; [`preset`]: the `paper` and `cpu` settings.
+//!   and its configuration; [`preset`]: the `paper` and `small` settings.
 //! - [`step`]: its training step through the shared loop (`crate::train::run`), L1 loss.
 //! - [`artifact`]: the saved network, checksummed, naming the DeepBRDF model whose latent it
 //!   predicts (or the 7 analytic attributes, for the baseline of the same CNN with 7 outputs).

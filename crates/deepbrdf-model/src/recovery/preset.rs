@@ -1,6 +1,6 @@
 //! The recovery CNN's presets: `paper` (§5.2: 256x256 inputs, Adam with learning rate 1e-3,
-//! batches of 64, 300 epochs; for a GPU) and `cpu` (64x64 inputs, narrower layers, fewer
-//! epochs: trains in minutes on two cores).
+//! batches of 64, 300 epochs; for a GPU) and `small` (64x64 inputs, narrower layers, fewer
+//! epochs: trains in minutes on two cores; its earlier name `cpu` still parses).
 
 use std::str::FromStr;
 
@@ -13,7 +13,7 @@ use super::network::RecoveryConfig;
 pub enum RecoveryPreset {
     /// 64x64 inputs; conv 5x5/2 (24), pool, conv 3x3 (48), pool, conv 3x3 (48), FC 128;
     /// Adam 1e-3 falling to 1e-4, batches of 32, 40 epochs.
-    Cpu,
+    Small,
     /// The paper: 256x256 inputs; conv 5x5/2 (32), pool, conv 3x3 (64), pool, conv 3x3/2 (64),
     /// FC 256; Adam 1e-3, batches of 64, 300 epochs.
     Paper,
@@ -23,7 +23,9 @@ impl RecoveryPreset {
     /// The network for `outputs` outputs.
     pub fn network(self, outputs: usize) -> RecoveryConfig {
         match self {
-            Self::Cpu => RecoveryConfig::new(64, [24, 48, 48], [5, 3, 3], [2, 1, 1], 128, outputs),
+            Self::Small => {
+                RecoveryConfig::new(64, [24, 48, 48], [5, 3, 3], [2, 1, 1], 128, outputs)
+            }
             Self::Paper => {
                 RecoveryConfig::new(256, [32, 64, 64], [5, 3, 3], [2, 1, 2], 256, outputs)
             }
@@ -33,7 +35,7 @@ impl RecoveryPreset {
     /// The training loop's settings.
     pub fn loop_config(self) -> LoopConfig {
         match self {
-            Self::Cpu => LoopConfig::new(adam())
+            Self::Small => LoopConfig::new(adam())
                 .with_learning_rate(1e-3)
                 .with_final_lr_factor(0.1)
                 .with_epochs(40)
@@ -48,13 +50,17 @@ impl RecoveryPreset {
     }
 }
 
-deepbrdf_data::named_enum!(RecoveryPreset { Cpu => "cpu", Paper => "paper" });
+deepbrdf_data::named_enum!(RecoveryPreset { Small => "small", Paper => "paper" });
 
 impl FromStr for RecoveryPreset {
     type Err = String;
 
+    /// A preset's name, or `cpu`, the earlier name of `small`.
     fn from_str(s: &str) -> Result<Self, Self::Err> {
+        if s.trim().eq_ignore_ascii_case("cpu") {
+            return Ok(Self::Small);
+        }
         Self::from_name(s)
-            .ok_or_else(|| format!("unknown recovery preset '{s}': expected cpu or paper"))
+            .ok_or_else(|| format!("unknown recovery preset '{s}': expected small or paper"))
     }
 }

@@ -109,13 +109,16 @@ fn a_tiny_recovery_cnn_learns_saves_and_names_its_model() {
 
 #[test]
 fn the_presets_fit_their_input_sides() {
-    for (preset, side) in [(RecoveryPreset::Cpu, 64), (RecoveryPreset::Paper, 256)] {
+    for (preset, side) in [(RecoveryPreset::Small, 64), (RecoveryPreset::Paper, 256)] {
         let c = preset.network(10);
         c.validate().unwrap();
         assert_eq!(c.input_side, side);
         assert!(c.flat_features() > 0);
         assert_eq!(preset.name().parse::<RecoveryPreset>().unwrap(), preset);
     }
+    // The earlier name of `small` still parses; others are refused naming the presets.
+    assert_eq!(" CPU".parse::<RecoveryPreset>().unwrap(), RecoveryPreset::Small);
+    assert!("tiny".parse::<RecoveryPreset>().unwrap_err().contains("small or paper"));
     assert_eq!(RecoveryPreset::Paper.network(10).sides(), [128, 64, 64, 32, 16]);
     assert_eq!(RecoveryPreset::Paper.loop_config().batch_size, 64);
     assert!(RecoveryConfig::new(8, [1, 1, 1], [4, 3, 3], [1, 1, 1], 4, 2).validate().is_err());

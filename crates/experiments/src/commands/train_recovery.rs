@@ -30,8 +30,9 @@ pub struct Args {
     /// Output folder: checkpoint, log, and the network in DIR/recovery.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// cpu (64x64 inputs, minutes on 2 cores) or paper (256x256, 300 epochs: for a GPU).
-    #[arg(long, default_value = "cpu", value_parser = parse_preset)]
+    /// small (64x64 inputs, minutes on 2 cores; `cpu` is its earlier name) or paper (256x256,
+    /// 300 epochs: for a GPU).
+    #[arg(long, default_value = "small", value_parser = parse_preset)]
     pub preset: RecoveryPreset,
     /// What the CNN predicts: latent (the model's) or attributes (7 Lambertian + GGX values).
     #[arg(long, default_value = "latent", value_parser = ["latent", "attributes"])]
@@ -43,7 +44,7 @@ pub struct Args {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Write a checkpoint at the end of an epoch once this many seconds have passed since the
-    /// last (default: the preset's, 30 s for cpu); 0 checkpoints every epoch.
+    /// last (default: the preset's, 30 s for small); 0 checkpoints every epoch.
     #[arg(long, value_name = "S")]
     pub checkpoint_seconds: Option<f64>,
     /// Continue an interrupted run in --out.
