@@ -42,16 +42,6 @@ pub struct Model {
     recovery: OnceLock<RecoveryArtifact>,
 }
 
-/// A colour edit from Python's `set` (three numbers) or `scale`.
-fn colour(name: &str, set: Option<[f64; 3]>, scale: Option<f64>) -> PyResult<Option<ColourEdit>> {
-    match (set, scale) {
-        (Some(_), Some(_)) => Err(value_error(format!("give {name} or {name}_scale, not both"))),
-        (Some(rgb), None) => Ok(Some(ColourEdit::Set(rgb))),
-        (None, Some(s)) => Ok(Some(ColourEdit::Scale(s))),
-        (None, None) => Ok(None),
-    }
-}
-
 impl Model {
     /// The regressor of eq. (7), loaded on first use.
     fn regressor(&self) -> PyResult<&Regressor> {
@@ -287,18 +277,12 @@ impl Model {
         roughness_scale: Option<f64>,
         mode: Option<&str>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let roughness = match (roughness, roughness_scale) {
-            (Some(_), Some(_)) => {
-                return Err(value_error("give roughness or roughness_scale, not both"))
-            }
-            (Some(r), None) => Some(ScalarEdit::Set(r)),
-            (None, Some(s)) => Some(ScalarEdit::Scale(s)),
-            (None, None) => None,
-        };
         let edit = Edit {
-            diffuse: colour("diffuse", diffuse, diffuse_scale)?,
-            specular: colour("specular", specular, specular_scale)?,
-            roughness,
+            diffuse: ColourEdit::set_or_scale("diffuse", diffuse, diffuse_scale).map_err(py_err)?,
+            specular: ColourEdit::set_or_scale("specular", specular, specular_scale)
+                .map_err(py_err)?,
+            roughness: ScalarEdit::set_or_scale("roughness", roughness, roughness_scale)
+                .map_err(py_err)?,
         };
         let mode = match mode {
             Some(name) => name.parse::<EditMode>().map_err(py_err)?,

@@ -23,6 +23,42 @@ pub enum ScalarEdit {
     Scale(f64),
 }
 
+impl ColourEdit {
+    /// The edit of an attribute given either as values to set or as a scale (a command's or
+    /// an API's two options for it): `None` for neither, an error naming `name` for both.
+    pub fn set_or_scale(
+        name: &str,
+        set: Option<[f64; 3]>,
+        scale: Option<f64>,
+    ) -> Result<Option<Self>> {
+        set_or_scale(name, set, scale, Self::Set, Self::Scale)
+    }
+}
+
+impl ScalarEdit {
+    /// [`ColourEdit::set_or_scale`] for the roughness.
+    pub fn set_or_scale(name: &str, set: Option<f64>, scale: Option<f64>) -> Result<Option<Self>> {
+        set_or_scale(name, set, scale, Self::Set, Self::Scale)
+    }
+}
+
+fn set_or_scale<T, E>(
+    name: &str,
+    set: Option<T>,
+    scale: Option<f64>,
+    to_set: impl FnOnce(T) -> E,
+    to_scale: impl FnOnce(f64) -> E,
+) -> Result<Option<E>> {
+    match (set, scale) {
+        (Some(_), Some(_)) => {
+            Err(EvalError::Invalid(format!("give {name} or {name}_scale, not both")))
+        }
+        (Some(v), None) => Ok(Some(to_set(v))),
+        (None, Some(s)) => Ok(Some(to_scale(s))),
+        (None, None) => Ok(None),
+    }
+}
+
 /// Which attribute an edit changes (for the measures: the others should not move).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum EditedAttribute {
@@ -113,6 +149,23 @@ impl Edit {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_attribute_is_set_or_scaled_not_both() {
+        let set = ColourEdit::set_or_scale("diffuse", Some([0.1, 0.2, 0.3]), None).unwrap();
+        assert_eq!(set, Some(ColourEdit::Set([0.1, 0.2, 0.3])));
+        assert_eq!(
+            ColourEdit::set_or_scale("diffuse", None, Some(2.0)).unwrap(),
+            Some(ColourEdit::Scale(2.0))
+        );
+        assert_eq!(ScalarEdit::set_or_scale("roughness", None, None).unwrap(), None);
+        assert_eq!(
+            ScalarEdit::set_or_scale("roughness", Some(0.2), None).unwrap(),
+            Some(ScalarEdit::Set(0.2))
+        );
+        let both = ScalarEdit::set_or_scale("roughness", Some(0.2), Some(2.0)).unwrap_err();
+        assert!(both.to_string().contains("give roughness or roughness_scale, not both"), "{both}");
+    }
 
     #[test]
     fn edits_apply_and_bad_values_are_named() {

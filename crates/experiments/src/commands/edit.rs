@@ -94,20 +94,13 @@ impl EditArgs {
     /// The edit these arguments ask for (values are checked when it is applied).
     pub fn edit(&self) -> anyhow::Result<Edit> {
         let colour = |flag: &str, set: &Option<String>, scale: Option<f64>| {
-            anyhow::Ok(match (set, scale) {
-                (Some(text), _) => Some(ColourEdit::Set(rgb(flag, text)?)),
-                (None, Some(s)) => Some(ColourEdit::Scale(s)),
-                (None, None) => None,
-            })
+            let set = set.as_deref().map(|text| rgb(flag, text)).transpose()?;
+            anyhow::Ok(ColourEdit::set_or_scale(flag, set, scale)?)
         };
         Ok(Edit {
             diffuse: colour("diffuse", &self.diffuse, self.diffuse_scale)?,
             specular: colour("specular", &self.specular, self.specular_scale)?,
-            roughness: match (self.roughness, self.roughness_scale) {
-                (Some(r), _) => Some(ScalarEdit::Set(r)),
-                (None, Some(s)) => Some(ScalarEdit::Scale(s)),
-                (None, None) => None,
-            },
+            roughness: ScalarEdit::set_or_scale("roughness", self.roughness, self.roughness_scale)?,
         })
     }
 }
