@@ -39,6 +39,20 @@ pub struct LeadingPairs {
     pub vectors: DMatrix<f64>,
 }
 
+impl LeadingPairs {
+    /// `W = U_k diag(1 / sigma)` (`n x k`), a zero column where `sigma_j` is 0: the weights
+    /// of the n centred rows in each principal direction, `v_j = (A - mu)^T W[:, j]`.
+    pub fn whitening(&self) -> DMatrix<f64> {
+        let mut w = DMatrix::<f64>::zeros(self.vectors.nrows(), self.sigmas.len());
+        for (j, &sigma) in self.sigmas.iter().enumerate() {
+            if sigma > 0.0 {
+                w.set_column(j, &(self.vectors.column(j) / sigma));
+            }
+        }
+        w
+    }
+}
+
 /// The `k` leading eigenpairs of `gram` (symmetrised first), eigenvalues at or below
 /// [`RELATIVE_EIGEN_FLOOR`] times the largest (or not positive) dropped.
 pub fn leading_eigenpairs(gram: DMatrix<f64>, k: usize) -> Result<LeadingPairs> {
@@ -105,6 +119,12 @@ mod tests {
             let gu = &gram * u;
             assert!((gu - u * pairs.sigmas[j].powi(2)).norm() < 1e-12, "column {j}");
         }
+        // The whitening divides each vector by its sigma and keeps the dropped one at zero.
+        let w = pairs.whitening();
+        for j in 0..3 {
+            assert!((w.column(j) * pairs.sigmas[j] - pairs.vectors.column(j)).norm() < 1e-12);
+        }
+        assert_eq!(w.column(3).norm(), 0.0);
         assert_eq!(pairs.vectors.column(3).norm(), 0.0, "the null direction is dropped");
         assert!(leading_eigenpairs(DMatrix::zeros(2, 3), 1).is_err());
     }

@@ -99,14 +99,7 @@ impl LinearBasis {
         let pairs = leading_eigenpairs(gram, k)?;
 
         // W = U_k diag(1/sigma) (n x k); a zero column for eigenvalues at the noise floor.
-        let mut w = DMatrix::<f64>::zeros(n, k);
-        for (j, &sigma) in pairs.sigmas.iter().enumerate() {
-            if sigma > 0.0 {
-                for i in 0..n {
-                    w[(i, j)] = pairs.vectors[(i, j)] / sigma;
-                }
-            }
-        }
+        let w = pairs.whitening();
         let singular_values = pairs.sigmas;
 
         // V = (A - mu)^T W, block by block: Vb = Xb W (block columns x k).

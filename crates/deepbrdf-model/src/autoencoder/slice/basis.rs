@@ -214,15 +214,7 @@ pub fn fit_weighted_components(
         &x * x.transpose()
     });
     let pairs = leading_eigenpairs(gram, k)?;
-    let mut w = DMatrix::<f64>::zeros(n, k);
-    for (j, &s) in pairs.sigmas.iter().enumerate() {
-        if s > 0.0 {
-            for i in 0..n {
-                w[(i, j)] = pairs.vectors[(i, j)] / s;
-            }
-        }
-    }
-    let wt = w.transpose();
+    let wt = pairs.whitening().transpose();
     let parts: Vec<DMatrix<f64>> = (0..blocks).into_par_iter().map(|b| &wt * centred(b)).collect();
     let mut rows = vec![0f32; k * len];
     for (b, part) in parts.iter().enumerate() {
