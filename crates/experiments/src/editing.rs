@@ -1,9 +1,8 @@
 //! What the editing commands (`edit`, `interpolate`, `figures-editing`, `serve`, `bench edit`)
-//! share on the command line: the model and regressor options, where a model's regressors live
-//! and how they load. The edits themselves (§5.1, eq. (7)) are the library's
+//! and `train-regressor` share on the command line: the model and regressor options, where a
+//! model's regressors live, how they load and how one is trained and saved. The edits themselves (§5.1, eq. (7)) are the library's
 //! ([`deepbrdf_eval::editing::space`]), re-exported here.
-use crate::commands::train_regressor::{self, IPCA_BASIS_FILE};
-use crate::model_arg::ModelArg;
+use crate::args::model::ModelArg;
 use anyhow::{bail, Context};
 use deepbrdf_data::dataset::Dataset;
 use deepbrdf_data::{MerlTable, Progress};
@@ -14,7 +13,10 @@ pub use deepbrdf_eval::editing::{
 };
 use deepbrdf_eval::harness::Codec as _;
 use deepbrdf_model::burn::tensor::Device;
-use deepbrdf_model::regressor::{Regressor, RegressorData, Target, TargetKind};
+use deepbrdf_model::regressor::{
+    train_regressor, Regressor, RegressorConfig, RegressorData, Target, TargetKind,
+};
+use deepbrdf_model::train::Session;
 use deepbrdf_model::DeepBrdf;
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
@@ -121,6 +123,51 @@ pub fn ipca_owner_id(basis: &BaselineBasis, k: usize) -> String {
     hex::encode(&h.finalize()[..16])
 }
 
+/// File name of the IPCA basis trained beside an IPCA regressor.
+pub const IPCA_BASIS_FILE: &str = "ipca.basis";
+
+/// The regressor's settings for `train-regressor`'s `--epochs` and `--seed`.
+pub fn config(epochs: Option<usize>, seed: u64) -> RegressorConfig {
+    let mut c = RegressorConfig::default();
+    if let Some(e) = epochs {
+        c.training = c.training.with_epochs(e);
+    }
+    c.training = c.training.with_seed(seed);
+    c
+}
+
+/// Trains one regressor in `out` (its run folder `out/runs/<kind>`, resumable) and saves it.
+pub fn train_into(
+    out: &Path,
+    data: &RegressorData,
+    config: &RegressorConfig,
+    target: Target,
+    progress: &dyn Progress,
+    device: &Device,
+) -> anyhow::Result<Regressor> {
+    let kind = target.kind;
+    let name = match kind {
+        TargetKind::DeepBrdf => "deepbrdf",
+        TargetKind::Ipca => "ipca",
+    };
+    let run_dir = out.join("runs").join(name);
+    let session = Session::new(&run_dir, true, progress, &format!("regressor ({name})"));
+    let regressor = train_regressor(data, config, target, &session, device)
+        .with_context(|| format!("training the {name} regressor in {}", run_dir.display()))?;
+    let path = out.join(kind.file_name());
+    regressor.save(&path)?;
+    println!(
+        "{kind} regressor: {} materials, {} epochs in {:.1} s, training relative error \
+         ||Y^-Y||/||Y|| {:.4} (in-sample) -> {}",
+        data.names.len(),
+        regressor.provenance().epochs,
+        regressor.provenance().train_seconds,
+        regressor.provenance().train_relative_error,
+        path.display()
+    );
+    Ok(regressor)
+}
+
 /// IPCA at `k` over `set` (attributes `attrs`) with its regressor, for editing through IPCA
 /// coefficients: the basis and regressor `train-regressor --ipca` saved in `reg_dir`, else a
 /// basis fitted and a regressor trained here on `set` (its files written to `scratch`).
@@ -159,9 +206,9 @@ pub fn ipca_editor(
                 attributes: attrs.iter().map(Attributes::to_array).collect(),
                 targets,
             };
-            let config = train_regressor::config(epochs, 0);
+            let config = config(epochs, 0);
             let target = Target { kind: TargetKind::Ipca, owner_id: owner, k };
-            train_regressor::train_into(scratch, &data, &config, target, progress, device)?
+            train_into(scratch, &data, &config, target, progress, device)?
         }
     };
     Ok((ipca, regressor))

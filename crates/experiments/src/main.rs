@@ -1,22 +1,15 @@
 //! `experiments`: the DeepBRDF command line. Thin: parse, dispatch, print the error chain.
+mod args;
 mod broken_pipe;
 mod cli;
 mod commands;
-mod corpus_arg;
-mod data_args;
-mod device_arg;
 mod editing;
-mod figure_arg;
 mod latent_file;
-mod model_arg;
 mod progress;
 mod progress_log;
 mod readme_block;
 mod recovery_inputs;
-mod refine_arg;
-mod scene_args;
 mod serve;
-mod time_limit_arg;
 mod warnings;
 
 use clap::Parser;

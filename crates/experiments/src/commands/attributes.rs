@@ -2,7 +2,7 @@
 //! diffuse albedo RGB, specular albedo RGB, GGX roughness: `deepbrdf_eval::attributes`) of every
 //! material of a dataset or of the named materials, writes them as CSV (atomically) and prints a
 //! table; `--relae` also measures the image RelAE of each analytic fit against its measurement.
-use crate::data_args::DataArgs;
+use crate::args::data::DataArgs;
 use anyhow::{bail, Context};
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::{MerlTable, Progress};

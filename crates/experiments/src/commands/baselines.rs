@@ -1,7 +1,7 @@
 //! `experiments baselines`: the PCA and IPCA baselines of §4 (Hu et al. 2020) through the
 //! evaluation harness: fit, encode/decode every material at each k, measure, print the summary
 //! table and write the results folder (CSV, markdown, Fig. 3 / Fig. 7 style plots).
-use crate::data_args::DataArgs;
+use crate::args::data::DataArgs;
 use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::Progress;
@@ -54,10 +54,10 @@ pub struct Args {
     #[arg(long, default_value = "slice")]
     pub preset: deepbrdf_model::Preset,
     #[command(flatten)]
-    pub refine: crate::refine_arg::RefineArg,
+    pub refine: crate::args::refine::RefineArg,
     /// The deepbrdf method stops each training at the end of the first epoch past this many
     /// seconds and is evaluated as far as it got (a rerun resumes the training).
-    #[arg(long, value_name = "SECONDS", value_parser = crate::time_limit_arg::parse)]
+    #[arg(long, value_name = "SECONDS", value_parser = crate::args::time_limit::parse)]
     pub time_limit: Option<std::time::Duration>,
     /// Where the deepbrdf method trains its models (`fold<F>/k<K>`) [default: <out>/models].
     #[arg(long, value_name = "DIR")]
@@ -132,7 +132,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let eval = if args.mode == Mode::Generalize {
         let t = Instant::now();
         let eval =
-            crate::data_args::load_collections(&args.eval_collections, &args.data, progress)?;
+            crate::args::data::load_collections(&args.eval_collections, &args.data, progress)?;
         eprintln!(
             "loaded {} ({} materials) in {:.1} s",
             eval.label,
@@ -145,7 +145,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     };
 
     let added = (!args.add_collections.is_empty())
-        .then(|| crate::data_args::load_added(&args.add_collections, &args.data.cache(), progress))
+        .then(|| crate::args::data::load_added(&args.add_collections, &args.data.cache(), progress))
         .transpose()?;
     let train_label = format!("{} ({} materials)", train.label, train.len());
     let added_label =
@@ -162,7 +162,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         Box::new(move |k| preset.train_config(k)),
         &models,
         &data_label,
-        crate::device_arg::device()?,
+        crate::args::device::device()?,
     )
     .retaining(&[])
     .refining(args.refine.refinement()?)

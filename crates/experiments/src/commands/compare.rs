@@ -1,26 +1,17 @@
 //! `experiments compare`: renders two materials under the same settings, prints RelAE (the
 //! paper's image-space error), RMSE and PSNR of the tonemapped images, and writes a false-colour
 //! difference image.
-use crate::data_args::CacheArg;
-use crate::scene_args::SceneArgs;
-use anyhow::{bail, Context};
+use crate::args::data::CacheArg;
+use crate::args::scene::SceneArgs;
+use anyhow::Context;
 use deepbrdf_data::dataset::load_material;
-use deepbrdf_data::rgl::{bundled, RglBrdf};
 use deepbrdf_data::Progress;
 use deepbrdf_eval::metrics::{compare_images, difference_image};
 use deepbrdf_render::brdf::MeasuredBrdf;
 use deepbrdf_render::{render, MerlBrdf};
 use std::path::PathBuf;
 
-/// The RGL evaluator of `spec` (material `which`, A or B, for `flag`): a `.bsdf` file or
-/// `rgl-measured/NAME`.
-pub(crate) fn load_evaluator(spec: &str, which: &str, flag: &str) -> anyhow::Result<RglBrdf> {
-    match spec.strip_prefix("rgl-measured/") {
-        Some(name) => Ok(bundled::load(name)?),
-        None if spec.ends_with(".bsdf") => Ok(RglBrdf::read(spec)?),
-        None => bail!("{flag} needs a .bsdf file or rgl-measured/NAME as {which}, not '{spec}'"),
-    }
-}
+use crate::args::measurement::load_evaluator;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {

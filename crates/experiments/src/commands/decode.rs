@@ -14,7 +14,7 @@ pub struct Args {
     #[arg(value_name = "[MODEL] LATENT", num_args = 1..=2, required = true)]
     pub inputs: Vec<String>,
     #[command(flatten)]
-    pub model: crate::model_arg::ModelArg,
+    pub model: crate::args::model::ModelArg,
     /// The MERL .binary file to write.
     #[arg(short, long, value_name = "FILE")]
     pub output: PathBuf,
@@ -24,7 +24,7 @@ pub struct Args {
 }
 
 pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
-    let device = crate::device_arg::device()?;
+    let device = crate::args::device::device()?;
     let (model_dir, input) = args.model.with_positional(&args.inputs)?;
     let model = DeepBrdf::load(&model_dir, &device)?;
     let latent = LatentFile::load(std::path::Path::new(&input))?;

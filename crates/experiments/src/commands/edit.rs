@@ -4,16 +4,16 @@
 //! material's diffuse albedo, specular albedo or roughness (§5.1) through the model's regressor
 //! (eq. 7) and decoder (eq. 3), or without a network (analytic, stretch), writes the edited MERL
 //! table, and prints the attributes asked for and those re-estimated on the result.
-use crate::data_args::CacheArg;
+use crate::args::data::CacheArg;
+use crate::args::edit::EditArgs;
+use crate::args::scene::SceneArgs;
 use crate::editing::{self, EditMode, EditorArg, DEFAULT_MODE};
-use crate::scene_args::SceneArgs;
 use anyhow::{bail, Context};
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::merl::write_merl;
 use deepbrdf_data::Progress;
 use deepbrdf_eval::attributes::{Attributes, FitConfig};
 use deepbrdf_eval::editing::edit_material;
-use deepbrdf_eval::editing::{ColourEdit, Edit, ScalarEdit};
 use deepbrdf_render::{render, MerlBrdf};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -46,63 +46,6 @@ pub struct Args {
     pub scene: SceneArgs,
     #[command(flatten)]
     pub cache: CacheArg,
-}
-
-/// The attribute changes of `edit` (shared with `bench edit`).
-#[derive(Debug, Clone, Default, clap::Args)]
-pub struct EditArgs {
-    /// Set the diffuse albedo (each in [0, 1]).
-    #[arg(
-        long,
-        value_name = "R,G,B",
-        conflicts_with = "diffuse_scale",
-        allow_hyphen_values = true
-    )]
-    pub diffuse: Option<String>,
-    /// Multiply the diffuse albedo.
-    #[arg(long, value_name = "X", allow_hyphen_values = true)]
-    pub diffuse_scale: Option<f64>,
-    /// Set the specular albedo (each in [0, 1]).
-    #[arg(
-        long,
-        value_name = "R,G,B",
-        conflicts_with = "specular_scale",
-        allow_hyphen_values = true
-    )]
-    pub specular: Option<String>,
-    /// Multiply the specular albedo.
-    #[arg(long, value_name = "X", allow_hyphen_values = true)]
-    pub specular_scale: Option<f64>,
-    /// Set the roughness (GGX alpha, > 0).
-    #[arg(long, value_name = "X", conflicts_with = "roughness_scale", allow_hyphen_values = true)]
-    pub roughness: Option<f64>,
-    /// Multiply the roughness.
-    #[arg(long, value_name = "X", allow_hyphen_values = true)]
-    pub roughness_scale: Option<f64>,
-}
-
-fn rgb(flag: &str, text: &str) -> anyhow::Result<[f64; 3]> {
-    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    let values: Option<Vec<f64>> = parts.iter().map(|p| p.parse::<f64>().ok()).collect();
-    match values {
-        Some(v) if v.len() == 3 => Ok([v[0], v[1], v[2]]),
-        _ => bail!("--{flag} '{text}': expected three numbers R,G,B"),
-    }
-}
-
-impl EditArgs {
-    /// The edit these arguments ask for (values are checked when it is applied).
-    pub fn edit(&self) -> anyhow::Result<Edit> {
-        let colour = |flag: &str, set: &Option<String>, scale: Option<f64>| {
-            let set = set.as_deref().map(|text| rgb(flag, text)).transpose()?;
-            anyhow::Ok(ColourEdit::set_or_scale(flag, set, scale)?)
-        };
-        Ok(Edit {
-            diffuse: colour("diffuse", &self.diffuse, self.diffuse_scale)?,
-            specular: colour("specular", &self.specular, self.specular_scale)?,
-            roughness: ScalarEdit::set_or_scale("roughness", self.roughness, self.roughness_scale)?,
-        })
-    }
 }
 
 /// `diffuse 0.123 0.456 0.789, specular ..., roughness ...`.
@@ -141,7 +84,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let (edited, by) = match mode.needs_network() {
         false => (edit_material(&table, &original, &edit, mode, None)?, "no network".to_string()),
         true => {
-            let device = crate::device_arg::device()?;
+            let device = crate::args::device::device()?;
             let model_dir = args.editor.model.dir()?;
             let (model, regressor) =
                 editing::load_editor(&model_dir, args.editor.regressor.as_deref(), &device)?;

@@ -9,7 +9,7 @@
 //! material's (`deepbrdf_eval::editing::known`).
 //!
 //! Writes `results.md` (the tally per method and edit) and `known.csv` (every edit).
-use crate::data_args::DataArgs;
+use crate::args::data::DataArgs;
 use crate::editing::{self, EditMode, EditorArg, ModelCodec, Space};
 use anyhow::Context;
 use deepbrdf_data::corpus::{self, Material};
@@ -165,7 +165,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let started = Instant::now();
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
-    let device = crate::device_arg::device()?;
+    let device = crate::args::device::device()?;
     let (model_dir, model, deep_regressor) = args.editor.load(&device)?;
     let k = model.k();
     let fit = FitConfig::default();

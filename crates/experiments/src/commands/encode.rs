@@ -10,18 +10,18 @@ use std::path::PathBuf;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(flatten)]
-    pub input: crate::model_arg::ModelMaterialArg,
+    pub input: crate::args::model::ModelMaterialArg,
     /// Write the latent vector (with the model's id) to this JSON file.
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
     #[command(flatten)]
-    pub refine: crate::refine_arg::RefineArg,
+    pub refine: crate::args::refine::RefineArg,
     #[command(flatten)]
-    pub cache: crate::data_args::CacheArg,
+    pub cache: crate::args::data::CacheArg,
 }
 
 pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
-    let device = crate::device_arg::device()?;
+    let device = crate::args::device::device()?;
     let (model_dir, input) = args.input.resolve()?;
     let model = DeepBrdf::load(&model_dir, &device)?.with_refinement(args.refine.refinement()?);
     let (name, table) = load_material(&input, &args.cache.cache())

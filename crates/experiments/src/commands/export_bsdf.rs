@@ -4,7 +4,7 @@
 //! Jakob 2018), which Mitsuba 3's and pbrt-v4's `measured` materials read
 //! (`deepbrdf_data::rgl::export`). Prints the file's resolutions and the time the export took.
 //! An existing output is never overwritten without `--force`.
-use crate::data_args::CacheArg;
+use crate::args::data::CacheArg;
 use anyhow::{bail, Context};
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::rgl::{export, ExportResolution};

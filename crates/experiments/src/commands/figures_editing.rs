@@ -24,7 +24,7 @@
 //! Writes `results.md` (the tables), `suite.csv` (every material and edit) and the figures.
 use super::editing_suite::{lobe_columns, lobe_summary, SuiteRow, SUITE_METHODS};
 use super::interpolate::{self, Path3};
-use crate::data_args::DataArgs;
+use crate::args::data::DataArgs;
 use crate::editing::{self, EditMode, EditorArg, ModelCodec, Space};
 use anyhow::Context;
 use deepbrdf_data::{MerlTable, Progress};
@@ -54,7 +54,7 @@ pub struct Args {
     pub epochs: Option<usize>,
     /// The figures' renders.
     #[command(flatten)]
-    pub figure: crate::figure_arg::FigureArg,
+    pub figure: crate::args::figure::FigureArg,
     /// Skip the figures (suite only).
     #[arg(long)]
     pub no_figures: bool,
@@ -108,7 +108,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let figure = args.figure.config()?;
-    let device = crate::device_arg::device()?;
+    let device = crate::args::device::device()?;
     let (model_dir, model, deep_regressor) = args.editor.load(&device)?;
     let k = model.k();
     let set = args.data.load(progress)?;
@@ -144,7 +144,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         model.id(),
         set.len(),
         set.label,
-        crate::model_arg::shown(&reg_dir)
+        crate::args::model::shown(&reg_dir)
     );
 
     let mut sweeps_md = String::new();

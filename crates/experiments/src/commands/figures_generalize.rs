@@ -5,9 +5,9 @@
 //! data; the image RelAE of each reconstruction under its caption (the harness's measure,
 //! [`ImageRelae`]: the preview sphere, sun and sky), rendered at the figure settings
 //! (`--size`, `--spp`, `--seed`), with the renderer's noise measured beside it.
-use crate::data_args::{load_added, CacheArg};
+use crate::args::data::{load_added, CacheArg};
+use crate::args::model::ModelArg;
 use crate::editing::ModelCodec;
-use crate::model_arg::ModelArg;
 use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::dataset::{DataSource, Dataset};
@@ -42,7 +42,7 @@ pub struct Args {
     #[arg(long, value_name = "DIR", default_value = "results/fig9")]
     pub out: PathBuf,
     #[command(flatten)]
-    pub figure: crate::figure_arg::FigureArg,
+    pub figure: crate::args::figure::FigureArg,
     #[command(flatten)]
     pub cache: CacheArg,
 }
@@ -82,7 +82,7 @@ struct Row {
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let config = args.figure.config()?;
-    let device = crate::device_arg::device()?;
+    let device = crate::args::device::device()?;
     let model = DeepBrdf::load(&args.model.dir()?, &device)?;
     let k = model.k();
     let cache = args.cache.cache();

@@ -5,7 +5,7 @@
 //! [`ImageRelae`], at the figure settings `--size`, `--spp`, `--seed`) and the renderer's noise
 //! measured beside it. A shown material a model was trained on makes the figure in-sample; the
 //! summary says so.
-use crate::data_args::CacheArg;
+use crate::args::data::CacheArg;
 use crate::editing::ModelCodec;
 use anyhow::{bail, Context};
 use deepbrdf_data::dataset::{DataSource, Dataset};
@@ -37,7 +37,7 @@ pub struct Args {
     #[arg(long, value_name = "DIR", default_value = "results/fig4")]
     pub out: PathBuf,
     #[command(flatten)]
-    pub figure: crate::figure_arg::FigureArg,
+    pub figure: crate::args::figure::FigureArg,
     #[command(flatten)]
     pub cache: CacheArg,
 }
@@ -61,7 +61,7 @@ fn load(
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let config = args.figure.config()?;
-    let device = crate::device_arg::device()?;
+    let device = crate::args::device::device()?;
     let mut models = Vec::with_capacity(args.models.len());
     for dir in &args.models {
         models.push(load(dir, &device)?);

@@ -16,9 +16,9 @@
 //! Like the paper's figures both are in-sample by default: the shipped model and PCA and IPCA
 //! fitted on the whole dataset have seen every material shown. `--held-out` fits PCA and IPCA
 //! without the Fig. 6 materials and refuses a model trained on any of them.
-use crate::data_args::DataArgs;
+use crate::args::data::DataArgs;
+use crate::args::model::ModelArg;
 use crate::editing::ModelCodec;
-use crate::model_arg::ModelArg;
 use anyhow::{bail, Context};
 use deepbrdf_data::files::write_atomic;
 use deepbrdf_data::{MerlTable, Progress, Silent};
@@ -55,7 +55,7 @@ pub struct Args {
     pub ks: Vec<usize>,
     /// Fig. 6's renders.
     #[command(flatten)]
-    pub figure: crate::figure_arg::FigureArg,
+    pub figure: crate::args::figure::FigureArg,
     /// Fig. 5: at most this many materials shown as a render with their name.
     #[arg(long, default_value_t = 24)]
     pub labels: usize,
@@ -99,7 +99,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     if args.materials.is_empty() {
         bail!("--materials must name at least one material");
     }
-    let device = crate::device_arg::device()?;
+    let device = crate::args::device::device()?;
     let model_dir = args.model.dir()?;
     let model = DeepBrdf::load(&model_dir, &device)
         .with_context(|| format!("loading the model {}", model_dir.display()))?;

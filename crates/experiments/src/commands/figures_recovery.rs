@@ -14,8 +14,8 @@
 //! reported beside it. The figures re-render the shown tables at `--figure-size` and
 //! `--figure-spp` (Sobol points) and state the renderer's noise there; the input column is the
 //! image as the network sees it.
-use crate::data_args::CacheArg;
-use crate::model_arg::ModelArg;
+use crate::args::data::CacheArg;
+use crate::args::model::ModelArg;
 use crate::recovery_inputs::{load_tables, set_images};
 use anyhow::{bail, Context};
 use deepbrdf_data::{MerlTable, Progress};
@@ -43,7 +43,7 @@ pub struct Args {
     #[command(flatten)]
     pub model: ModelArg,
     #[command(flatten)]
-    pub network: super::recover::NetworkArg,
+    pub network: crate::args::network::NetworkArg,
     /// The analytic baseline: a recovery network trained with `--target attributes`.
     #[arg(long, value_name = "DIR")]
     pub analytic: PathBuf,
@@ -127,7 +127,7 @@ fn figure_tiles(
 }
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
-    let device = crate::device_arg::device()?;
+    let device = crate::args::device::device()?;
     let model_dir = args.model.dir()?;
     let model = DeepBrdf::load(&model_dir, &device)?;
     let network = args.network.load(&model_dir, &model)?;

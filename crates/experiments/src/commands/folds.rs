@@ -1,7 +1,7 @@
 //! `experiments folds`: which materials each fold of the harness scores (the split every
 //! k-fold command uses, deterministic in the seed), so a held-out experiment on one fold can
 //! be set up by hand: `experiments folds --fold 0` lists fold 0's materials, one a line.
-use crate::data_args::DataArgs;
+use crate::args::data::DataArgs;
 use anyhow::bail;
 use deepbrdf_data::Progress;
 use deepbrdf_eval::harness::Mode;

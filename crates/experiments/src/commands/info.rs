@@ -1,7 +1,7 @@
 //! `experiments info FILE_OR_MATERIAL`: what a MERL table holds: its header, the fraction of
 //! valid cells, per-channel min/median/max over valid cells, and the hemispherical albedo at
 //! normal incidence (`deepbrdf_data::summary`).
-use crate::data_args::CacheArg;
+use crate::args::data::CacheArg;
 use anyhow::Context;
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::dataset::load_material;

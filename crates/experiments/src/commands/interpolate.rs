@@ -4,9 +4,9 @@
 //! (one row per path), the DeepBRDF tables (`--all-tables`: every path's) and `summary.md` with
 //! each path's uniformity (coefficient of variation of the image RelAE between consecutive steps)
 //! and plausibility.
-use crate::data_args::DataArgs;
+use crate::args::data::DataArgs;
+use crate::args::model::ModelArg;
 use crate::editing::{blend, blend_tables, ModelCodec};
-use crate::model_arg::ModelArg;
 use anyhow::{bail, Context};
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::merl::write_merl;
@@ -41,7 +41,7 @@ pub struct Args {
     pub ipca_basis: Option<PathBuf>,
     /// The strip's renders.
     #[command(flatten)]
-    pub figure: crate::figure_arg::FigureArg,
+    pub figure: crate::args::figure::FigureArg,
     /// Write every path's tables, not only DeepBRDF's (35 MB each).
     #[arg(long)]
     pub all_tables: bool,
@@ -72,7 +72,7 @@ pub fn ipca_basis(
     progress: &dyn Progress,
 ) -> anyhow::Result<Arc<BaselineBasis>> {
     let shipped =
-        model_dir.join(crate::editing::REGRESSOR_DIR).join(super::train_regressor::IPCA_BASIS_FILE);
+        model_dir.join(crate::editing::REGRESSOR_DIR).join(crate::editing::IPCA_BASIS_FILE);
     let path = given.map(Path::to_path_buf).or_else(|| shipped.exists().then_some(shipped));
     Ok(Arc::new(match path {
         Some(p) => BaselineBasis::load(&p).with_context(|| format!("loading {}", p.display()))?,
@@ -200,7 +200,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         load_material(&args.a, &cache).with_context(|| format!("loading '{}'", args.a))?;
     let (name_b, b) =
         load_material(&args.b, &cache).with_context(|| format!("loading '{}'", args.b))?;
-    let device = crate::device_arg::device()?;
+    let device = crate::args::device::device()?;
     let model = DeepBrdf::load(&model_dir, &device)
         .with_context(|| format!("loading the model {}", model_dir.display()))?;
     let basis =

@@ -41,7 +41,7 @@ pub mod train_regressor;
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     let progress = Bars::new(cli.quiet);
-    crate::device_arg::select(cli.device);
+    crate::args::device::select(cli.device);
     match cli.command {
         Command::Devices(args) => devices::run(args, &progress),
         Command::Bench(args) => bench::run(args, &progress),

@@ -14,7 +14,7 @@ use std::path::PathBuf;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(flatten)]
-    pub input: crate::model_arg::ModelMaterialArg,
+    pub input: crate::args::model::ModelMaterialArg,
     /// The MERL .binary file to write.
     #[arg(short, long, value_name = "FILE")]
     pub output: PathBuf,
@@ -22,9 +22,9 @@ pub struct Args {
     #[arg(long, value_name = "1/N")]
     pub slices: Option<String>,
     #[command(flatten)]
-    pub refine: crate::refine_arg::RefineArg,
+    pub refine: crate::args::refine::RefineArg,
     #[command(flatten)]
-    pub cache: crate::data_args::CacheArg,
+    pub cache: crate::args::data::CacheArg,
 }
 
 /// Parses `1/N` into every-N-th slice selection.
@@ -41,7 +41,7 @@ fn parse_fraction(s: &str) -> anyhow::Result<SliceSelection> {
 }
 
 pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
-    let device = crate::device_arg::device()?;
+    let device = crate::args::device::device()?;
     let (model_dir, input) = args.input.resolve()?;
     let model = DeepBrdf::load(&model_dir, &device)?.with_refinement(args.refine.refinement()?);
     let (name, table) = load_material(&input, &args.cache.cache())

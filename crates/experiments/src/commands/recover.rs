@@ -1,18 +1,16 @@
 //! `experiments recover [--model DIR] IMAGE -o out.binary [--render compare.png]`: single-image
 //! BRDF recovery (§5.2, Fig. 15): the recovery CNN maps the photo to the model's latent vector
 //! and the model's decoder (eq. 3) turns it into a full MERL table.
-use crate::model_arg::ModelArg;
-use anyhow::Context;
+use crate::args::model::ModelArg;
+use crate::args::network::NetworkArg;
 use deepbrdf_data::merl::write_merl;
 use deepbrdf_data::Progress;
-use deepbrdf_model::recovery::artifact::RECOVERY_DIR;
-use deepbrdf_model::recovery::RecoveryArtifact;
 use deepbrdf_model::DeepBrdf;
 use deepbrdf_render::photo::input_preview;
 use deepbrdf_render::{
     render, MerlBrdf, Photo, RenderSettings, Sampler, SceneConfig, Srgb8Image, Tonemap,
 };
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// The arguments of `recover` (its assumptions about the photo: the command's help in `cli.rs`).
@@ -33,31 +31,8 @@ pub struct Args {
     pub render: Option<PathBuf>,
 }
 
-/// `--network DIR`: the recovery network of a model.
-#[derive(Debug, Clone, clap::Args)]
-pub struct NetworkArg {
-    /// The recovery network [default: MODEL/recovery, where `train-recovery --out MODEL` and
-    /// the shipped model place it].
-    #[arg(long, value_name = "DIR")]
-    pub network: Option<PathBuf>,
-}
-
-impl NetworkArg {
-    /// The network of the model in `model_dir`, loaded and checked to predict `model`'s latent.
-    pub fn load(&self, model_dir: &Path, model: &DeepBrdf) -> anyhow::Result<RecoveryArtifact> {
-        let dir = match &self.network {
-            Some(n) => n.clone(),
-            None => model_dir.join(RECOVERY_DIR),
-        };
-        let network = RecoveryArtifact::load(&dir)
-            .with_context(|| format!("loading the recovery network {}", dir.display()))?;
-        network.check_model(model.id())?;
-        Ok(network)
-    }
-}
-
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
-    let device = crate::device_arg::device()?;
+    let device = crate::args::device::device()?;
     let model_dir = args.model.dir()?;
     let model = DeepBrdf::load(&model_dir, &device)?;
     let network = args.network.load(&model_dir, &model)?;

@@ -1,7 +1,7 @@
 //! `experiments render`: renders one material (a MERL .binary file or a bundled material) to a
 //! tonemapped PNG and, optionally, a linear OpenEXR.
-use crate::data_args::CacheArg;
-use crate::scene_args::SceneArgs;
+use crate::args::data::CacheArg;
+use crate::args::scene::SceneArgs;
 use anyhow::Context;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::Progress;

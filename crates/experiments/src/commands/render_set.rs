@@ -6,7 +6,7 @@
 //! `--exclude-fold I/N` leaves out the materials of fold I of the harness's N-fold split
 //! (`deepbrdf_eval::harness::Mode::KFold`, seed `--fold-seed`), `--only-fold I/N` keeps only
 //! them (the held-out test images).
-use crate::data_args::{cache_at, DataArgs};
+use crate::args::data::{cache_at, DataArgs};
 use anyhow::{bail, Context};
 use deepbrdf_data::dataset::{binary_files, load_material, DataSource};
 use deepbrdf_data::lock::FolderLock;

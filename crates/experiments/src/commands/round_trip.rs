@@ -4,9 +4,9 @@
 //! evaluator; prints a table of image RelAE against the original measurement beside the MERL
 //! table's own and the bar of `export-bsdf` (at most 1.5 times the table's own). Default: the
 //! seven bundled `rgl-measured` measurements, in `compare`'s scene.
-use super::compare::load_evaluator;
-use crate::data_args::CacheArg;
-use crate::scene_args::SceneArgs;
+use crate::args::data::CacheArg;
+use crate::args::measurement::load_evaluator;
+use crate::args::scene::SceneArgs;
 use anyhow::Context;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::rgl::{bundled, ExportResolution};

@@ -2,7 +2,7 @@
 //! (§5.1's edits, interactively): pick or drop a material, move the 7 attribute sliders and a blend slider, see
 //! the original and the edited material side by side, download the edited `.binary` and its
 //! latent. Binds 127.0.0.1 unless told otherwise; see [`crate::serve`].
-use crate::data_args::CacheArg;
+use crate::args::data::CacheArg;
 use crate::editing::EditorArg;
 use crate::serve::editor::EditorHandle;
 use crate::serve::request::{bundled_ids, Catalogue};

@@ -1,7 +1,7 @@
 //! `experiments sheet`: every material of a dataset rendered on the same scene, in one contact
 //! sheet with the material names as captions.
-use crate::data_args::DataArgs;
-use crate::scene_args::SceneArgs;
+use crate::args::data::DataArgs;
+use crate::args::scene::SceneArgs;
 use deepbrdf_data::Progress;
 use deepbrdf_data::Silent;
 use deepbrdf_render::{contact_sheet, render, MerlBrdf, SheetConfig, Tile};

@@ -10,7 +10,7 @@
 //!
 //! Models are trained into `<out>/models/fold<F>/k<K>` with resume on: rerunning an interrupted
 //! sweep continues where it stopped, and finished models are loaded, not retrained.
-use crate::data_args::DataArgs;
+use crate::args::data::DataArgs;
 use crate::progress_log::ProgressLog;
 use crate::readme_block;
 use anyhow::{bail, Context};
@@ -56,7 +56,7 @@ pub struct Args {
     #[arg(long, default_value = "slice")]
     pub preset: Preset,
     #[command(flatten)]
-    pub refine: crate::refine_arg::RefineArg,
+    pub refine: crate::args::refine::RefineArg,
     /// Train with this configuration instead of a preset (JSON, as a run's `train_config.json`);
     /// its k is replaced by each k of the sweep.
     #[arg(long, value_name = "FILE")]
@@ -190,8 +190,8 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
     let config_for = args.config_for()?;
     let deep_ks = args.deep_ks()?;
     let fig2_ks = args.fig2_ks()?;
-    let kind = crate::device_arg::kind()?;
-    let device = crate::device_arg::device()?;
+    let kind = crate::args::device::kind()?;
+    let device = crate::args::device::device()?;
     let out = args.out_dir();
     // Held until the sweep ends: a second run on the same folder is refused.
     let _lock = deepbrdf_data::lock::FolderLock::acquire(&out)?;
@@ -202,7 +202,7 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
         Mode::Generalize => {
             let collections =
                 args.eval_collections.clone().unwrap_or_else(|| vec![Collection::RglMeasured]);
-            Some(crate::data_args::load_collections(&collections, &args.data, progress)?)
+            Some(crate::args::data::load_collections(&collections, &args.data, progress)?)
         }
         _ => None,
     };

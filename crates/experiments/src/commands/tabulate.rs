@@ -1,7 +1,7 @@
 //! `experiments tabulate`: writes MERL `.binary` files tabulated from the bundled NBRDF networks
 //! (a whole collection, or one material), through the table cache. An existing file with other
 //! content is never overwritten without `--force`; identical files are left as they are.
-use crate::data_args::CacheArg;
+use crate::args::data::CacheArg;
 use anyhow::bail;
 use deepbrdf_data::bundled::{find_material, Collection};
 use deepbrdf_data::merl::io::{write_merl, MerlFile};

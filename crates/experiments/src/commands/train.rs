@@ -5,7 +5,7 @@
 //! continues an interrupted one exactly where its last checkpoint left it, with the settings
 //! saved in its checkpoint. The model is written to `DIR/model`; `DIR/train_log.csv` has one row
 //! per epoch.
-use crate::data_args::DataArgs;
+use crate::args::data::DataArgs;
 use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::lock::FolderLock;
@@ -70,7 +70,7 @@ pub struct Args {
     /// Stop at the end of the first epoch past this many seconds of training, writing the model
     /// of the epochs done so far (its provenance says how many) and keeping the checkpoint, so
     /// `--resume` continues the run (for a machine lent for a bounded time).
-    #[arg(long, value_name = "SECONDS", value_parser = crate::time_limit_arg::parse)]
+    #[arg(long, value_name = "SECONDS", value_parser = crate::args::time_limit::parse)]
     pub time_limit: Option<std::time::Duration>,
     /// Continue the interrupted run in DIR (or in --out), with its saved settings.
     #[arg(long, value_name = "DIR", num_args = 0..=1)]
@@ -83,7 +83,7 @@ pub struct Args {
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     pub add_collections: Vec<Collection>,
     #[command(flatten)]
-    pub corpus: crate::corpus_arg::CorpusArg,
+    pub corpus: crate::args::corpus::CorpusArg,
 }
 
 fn parse_preset(s: &str) -> Result<Preset, String> {
@@ -146,8 +146,8 @@ impl Args {
 }
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
-    let device = crate::device_arg::device()?;
-    let kind = crate::device_arg::kind()?;
+    let device = crate::args::device::device()?;
+    let kind = crate::args::device::kind()?;
     let resume_dir = args.resume.clone().map(|d| d.or_else(|| args.out.clone()));
     // Held until the run ends: a second run on the same folder is refused.
     let lock: FolderLock;
@@ -188,7 +188,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let mut data = args.data.load(progress)?;
     if !args.add_collections.is_empty() {
         let more =
-            crate::data_args::load_added(&args.add_collections, &args.data.cache(), progress)?;
+            crate::args::data::load_added(&args.add_collections, &args.data.cache(), progress)?;
         data.label = format!("{}+{}", data.label, more.label);
         data.names.extend(more.names);
         data.tables.extend(more.tables);

@@ -3,8 +3,8 @@
 //! material; `--target attributes` trains the same CNN with 7 outputs on the Lambertian + GGX
 //! attributes instead (the analytic baseline). Resumable (`--resume`); the network is saved to
 //! `DIR/recovery` and names the model whose latent it predicts.
-use crate::data_args::CacheArg;
-use crate::model_arg::ModelArg;
+use crate::args::data::CacheArg;
+use crate::args::model::ModelArg;
 use crate::recovery_inputs::{load_tables, set_images};
 use anyhow::bail;
 use deepbrdf_data::lock::FolderLock;
@@ -59,7 +59,7 @@ fn parse_preset(s: &str) -> Result<RecoveryPreset, String> {
 }
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
-    let device = crate::device_arg::device()?;
+    let device = crate::args::device::device()?;
     let set = RenderSet::load(&args.set)?;
     let _lock = FolderLock::acquire(&args.out)?;
     let tables = load_tables(&set.header.materials, &args.cache.cache(), progress)?;

@@ -5,24 +5,17 @@
 //! training loop; saved as `<out>/deepbrdf.regressor` (default out: `<model>/regressor/`), naming
 //! the model. With `--ipca`, also an IPCA basis at the same k (`ipca.basis`) and the regressor of
 //! its coefficients (`ipca.regressor`), for the paper's Fig. 14 comparison.
-use crate::data_args::DataArgs;
-use crate::editing::{self, ipca_owner_id};
-use crate::model_arg::ModelArg;
+use crate::args::data::DataArgs;
+use crate::args::model::ModelArg;
+use crate::editing::{self, config, ipca_owner_id, train_into, IPCA_BASIS_FILE};
 use anyhow::{bail, Context};
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::attributes::FitConfig;
 use deepbrdf_eval::baseline::{BaselineBasis, MappingKind};
-use deepbrdf_model::burn::tensor::Device;
-use deepbrdf_model::regressor::{
-    train_regressor, Regressor, RegressorConfig, RegressorData, Target, TargetKind,
-};
-use deepbrdf_model::train::Session;
+use deepbrdf_model::regressor::{RegressorData, Target, TargetKind};
 use deepbrdf_model::DeepBrdf;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
-
-/// File name of the IPCA basis trained beside an IPCA regressor.
-pub const IPCA_BASIS_FILE: &str = "ipca.basis";
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -47,49 +40,7 @@ pub struct Args {
     #[command(flatten)]
     pub data: DataArgs,
     #[command(flatten)]
-    pub corpus: crate::corpus_arg::CorpusArg,
-}
-
-/// The regressor's settings for these arguments.
-pub fn config(epochs: Option<usize>, seed: u64) -> RegressorConfig {
-    let mut c = RegressorConfig::default();
-    if let Some(e) = epochs {
-        c.training = c.training.with_epochs(e);
-    }
-    c.training = c.training.with_seed(seed);
-    c
-}
-
-/// Trains one regressor in `out` (its run folder `out/runs/<kind>`, resumable) and saves it.
-pub fn train_into(
-    out: &Path,
-    data: &RegressorData,
-    config: &RegressorConfig,
-    target: Target,
-    progress: &dyn Progress,
-    device: &Device,
-) -> anyhow::Result<Regressor> {
-    let kind = target.kind;
-    let name = match kind {
-        TargetKind::DeepBrdf => "deepbrdf",
-        TargetKind::Ipca => "ipca",
-    };
-    let run_dir = out.join("runs").join(name);
-    let session = Session::new(&run_dir, true, progress, &format!("regressor ({name})"));
-    let regressor = train_regressor(data, config, target, &session, device)
-        .with_context(|| format!("training the {name} regressor in {}", run_dir.display()))?;
-    let path = out.join(kind.file_name());
-    regressor.save(&path)?;
-    println!(
-        "{kind} regressor: {} materials, {} epochs in {:.1} s, training relative error \
-         ||Y^-Y||/||Y|| {:.4} (in-sample) -> {}",
-        data.names.len(),
-        regressor.provenance().epochs,
-        regressor.provenance().train_seconds,
-        regressor.provenance().train_relative_error,
-        path.display()
-    );
-    Ok(regressor)
+    pub corpus: crate::args::corpus::CorpusArg,
 }
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
@@ -107,7 +58,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             .with_context(|| format!("removing the old runs in {}", out.display()))?;
     }
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
-    let device = crate::device_arg::device()?;
+    let device = crate::args::device::device()?;
     let set = args.data.load(progress)?;
     let streamed = args.corpus.streamed()?;
     let model = DeepBrdf::load(&model_dir, &device)

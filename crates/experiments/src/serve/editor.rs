@@ -96,7 +96,7 @@ impl EditorHandle {
         let (worker_shared, worker_catalogue) = (shared.clone(), catalogue.clone());
         std::thread::Builder::new().name("editor".into()).spawn(move || {
             let loaded = (|| {
-                let device = crate::device_arg::device()?;
+                let device = crate::args::device::device()?;
                 editing::load_editor(&dir, regressor.as_deref(), &device)
             })();
             match loaded {

@@ -1,7 +1,7 @@
 //! Tests of the convolutions as matrix products ([`super::gemm`]) against Burn's own modules:
 //! outputs and input, weight and bias gradients at Table 1's spatial shapes (few channels) and
 //! at other strides, kernels and paddings, and a whole training step of a narrow Table 1, on
-//! every compiled CPU backend.
+//! every compiled backend.
 
 use burn::module::{ModuleVisitor, Param};
 use burn::nn::conv::{Conv2d, Conv2dConfig, ConvTranspose2d, ConvTranspose2dConfig};
@@ -15,11 +15,12 @@ use crate::device::DeviceKind;
 use crate::loss::LossNorm;
 use crate::training_set::TrainingSet;
 
-/// The compiled CPU backends (the GPU ones are measured on GPU machines).
-fn cpu_devices() -> Vec<(DeviceKind, Device)> {
+/// The compiled backends: flex and ndarray, and wgpu in a build with it (on a machine without
+/// a GPU, Mesa's lavapipe runs CubeCL's kernels: the operations the GPU runs, checked here).
+fn devices() -> Vec<(DeviceKind, Device)> {
     DeviceKind::available()
         .into_iter()
-        .filter(|k| matches!(k, DeviceKind::Flex | DeviceKind::Ndarray))
+        .filter(|k| matches!(k, DeviceKind::Flex | DeviceKind::Ndarray | DeviceKind::Wgpu))
         .map(|k| (k, k.device().unwrap()))
         .collect()
 }
@@ -131,7 +132,7 @@ fn check<L: Layer>(
     input: [usize; 4],
     out: Option<[usize; 3]>,
 ) {
-    for (kind, device) in cpu_devices() {
+    for (kind, device) in devices() {
         let device = device.autodiff();
         let layer = crate::seeded::with_seed(3, &device, || build(&device));
         let x = wavy(input, 0.4, &device);
@@ -215,7 +216,7 @@ fn other_kernels_strides_and_paddings_equal_burns() {
 
 #[test]
 fn batches_split_to_keep_buffers_small_give_the_same_result() {
-    let device = cpu_devices()[0].1.clone();
+    let device = devices()[0].1.clone();
     let x = wavy([5, 2, 3, 3], 0.1, &device);
     let f = |t: Tensor<4>| {
         let b = t.dims()[0];
@@ -255,7 +256,7 @@ fn a_training_step_of_a_narrow_table1_equals_the_direct_one() {
         .with_decoder_channels([3, 3]);
     let config = AutoencoderConfig::convolutional(2, layers);
     let set = layouts(2);
-    for (kind, device) in cpu_devices() {
+    for (kind, device) in devices() {
         let device = device.autodiff();
         let model = config.init_seeded(11, &device).unwrap();
         let step = |conv: ConvAlgorithm| {
@@ -275,8 +276,15 @@ fn a_training_step_of_a_narrow_table1_equals_the_direct_one() {
         );
         assert!(direct.len() > 20, "{kind}: {} gradients", direct.len());
         assert_eq!(gemm.len(), direct.len());
+        // Each gradient within 1e-5 of its own largest value, or of 1e-4 of the step's largest
+        // gradient where a parameter's is smaller than that (there it is f32 round-off: one
+        // bias's gradient sums to ~1e-9 from terms of ~1e-3).
+        let largest = direct.iter().flatten().fold(0f32, |m, v| m.max(v.abs()));
         for (i, (g, d)) in gemm.iter().zip(&direct).enumerate() {
-            assert_close(&format!("{kind}: parameter {i}"), g, d, 1e-5);
+            let own = d.iter().fold(0f32, |m, v| m.max(v.abs()));
+            let worst = g.iter().zip(d).map(|(a, b)| (a - b).abs()).fold(0f32, f32::max);
+            let scale = own.max(1e-4 * largest);
+            assert!(worst <= 1e-5 * scale, "{kind}: parameter {i}: {worst} against {scale}");
         }
     }
 }

@@ -3,8 +3,8 @@
 //! edit), the decode (eq. 3) and a 128-pixel preview render (sphere, sun and sky, 16 spp); the
 //! attribute fit and the encode of the material, done once when it is picked, are timed apart.
 //! Without an edit option the edit is roughness x0.5.
-use crate::commands::edit::EditArgs;
-use crate::data_args::CacheArg;
+use crate::args::data::CacheArg;
+use crate::args::edit::EditArgs;
 use crate::editing::{self, EditMode, EditorArg, ModelCodec, Space, DEFAULT_LATENT_MODE};
 use anyhow::Context;
 use deepbrdf_data::dataset::load_material;
@@ -36,7 +36,7 @@ pub struct Args {
 }
 
 pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
-    let device = crate::device_arg::device()?;
+    let device = crate::args::device::device()?;
     let t = Instant::now();
     let (_, model, regressor) = args.editor.load(&device)?;
     let load = t.elapsed().as_secs_f64();

@@ -41,8 +41,8 @@ fn parse_preset(s: &str) -> Result<Preset, String> {
 }
 
 pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
-    let kind = crate::device_arg::kind()?;
-    let device = crate::device_arg::device()?;
+    let kind = crate::args::device::kind()?;
+    let device = crate::args::device::device()?;
     let mut runs: Vec<(String, TrainConfig)> = match (args.preset, &args.config) {
         (Some(p), _) => vec![(p.name().to_string(), p.train_config(args.k))],
         (None, Some(_)) => Vec::new(),

@@ -1,7 +1,7 @@
 //! `experiments bench recover`: seconds of one `recover` (target: network + decode at
 //! most 0.5 s on 2 cores): reading and preparing the photo, the recovery CNN, and DeepBRDF's
 //! decode of its latent (eq. 3), each the median of `--repeats` runs after a warm-up.
-use crate::model_arg::ModelArg;
+use crate::args::model::ModelArg;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::{Progress, Silent};
 use deepbrdf_eval::stats::finite_median;
@@ -15,18 +15,18 @@ pub struct Args {
     #[command(flatten)]
     pub model: ModelArg,
     #[command(flatten)]
-    pub network: crate::commands::recover::NetworkArg,
+    pub network: crate::args::network::NetworkArg,
     /// The photo [default: a 256x256 render of gold-metallic-paint on the preview sphere].
     #[arg(long)]
     pub image: Option<PathBuf>,
     #[arg(long, default_value_t = 5)]
     pub repeats: usize,
     #[command(flatten)]
-    pub cache: crate::data_args::CacheArg,
+    pub cache: crate::args::data::CacheArg,
 }
 
 pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
-    let device = crate::device_arg::device()?;
+    let device = crate::args::device::device()?;
     let model_dir = args.model.dir()?;
     let model = DeepBrdf::load(&model_dir, &device)?;
     let network = args.network.load(&model_dir, &model)?;

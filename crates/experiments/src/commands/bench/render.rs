@@ -2,7 +2,7 @@
 //! tabulated MERL material under sun and sky at 64 spp in under 0.5 s on 2 cores). Prints MERL
 //! lookups per second, images per second, and the cost of the tabulated material relative to an
 //! analytic one measured in the same run.
-use crate::data_args::CacheArg;
+use crate::args::data::CacheArg;
 use anyhow::Context;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::{Progress, Silent};

@@ -13,7 +13,7 @@
 //! pairs of one renderer: 0.194, 0.085, 0.062). The `top` column says which share of the pooled
 //! squared difference comes from the 0.1% of pixels with the largest differences.
 use super::render::cpu_seconds;
-use crate::data_args::CacheArg;
+use crate::args::data::CacheArg;
 use anyhow::Context;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::{Progress, Silent};

@@ -2,7 +2,7 @@
 //! CPU default (64x64 px, 16 spp): `--images` images of the first `--materials` `merl`
 //! materials rendered into a temporary folder, the per-material sampler builds included, as
 //! `render-set` spends them.
-use crate::data_args::CacheArg;
+use crate::args::data::CacheArg;
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::Progress;

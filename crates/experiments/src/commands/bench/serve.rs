@@ -6,8 +6,8 @@
 //! refined previews; and a burst of 20 roughness moves 50 ms apart sent without waiting (the
 //! worst case: the page itself keeps one in flight), with the page and `/api/info` fetched
 //! during the burst.
+use crate::args::data::CacheArg;
 use crate::commands::serve::{runtime, start};
-use crate::data_args::CacheArg;
 use crate::editing::EditorArg;
 use anyhow::{bail, Context};
 use deepbrdf_data::Progress;
