@@ -183,6 +183,45 @@ fn bench_model_prints_the_decode_time_next_to_ipcas() {
 }
 
 #[test]
+fn bench_model_writes_the_readmes_decode_row_from_its_own_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let readme = dir.path().join("README.md");
+    let text =
+        "# T\n\nbefore\n<!-- bench-decode:begin -->\nold row\n<!-- bench-decode:end -->\nafter\n";
+    std::fs::write(&readme, text).unwrap();
+    let path = readme.to_str().unwrap();
+    let args =
+        ["bench", "model", "--preset", "slice", "--k", "3", "--steps", "1", "--decodes", "1"];
+    let mut with_readme = args.to_vec();
+    with_readme.extend(["--update-readme", path]);
+    let out = util::run_ok(dir.path(), &with_readme);
+    let printed = util::stdout(&out);
+    let line = printed.lines().find(|l| l.contains("decode vs IPCA's")).expect("a decode line");
+    let times: Vec<f64> = line
+        .split(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    let written = std::fs::read_to_string(&readme).unwrap();
+    assert!(written.starts_with("# T\n\nbefore\n<!-- bench-decode:begin -->\n"), "{written}");
+    assert!(written.ends_with("<!-- bench-decode:end -->\nafter\n"), "{written}");
+    assert!(!written.contains("old row"), "{written}");
+    // The block's numbers are this run's (3 decimals of the printed 4).
+    let [_, deep, ipca, _] = times[..] else { panic!("{line}") };
+    let row = written.lines().find(|l| l.contains(" s / ")).expect("the measured row");
+    let cell = row.split('|').find(|c| c.contains(" s / ")).unwrap();
+    let block: Vec<f64> = cell
+        .split(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    assert!((block[0] - deep).abs() <= 6e-4 && (block[1] - ipca).abs() <= 6e-4, "{row} vs {line}");
+    assert!(written.contains("--k 3 --steps 1 --decodes 1 --update-readme README.md"), "{written}");
+    // The paper preset has no decode row to write.
+    let mut paper = vec!["bench", "model", "--preset", "paper", "--update-readme", path];
+    paper.extend(["--steps", "1"]);
+    util::assert_clean_failure(&util::run_in(dir.path(), &paper), "--preset slice");
+}
+
+#[test]
 fn bench_model_times_both_convolution_algorithms_of_a_convolutional_network() {
     use deepbrdf_model::autoencoder::ConvolutionalConfig;
     use deepbrdf_model::AutoencoderConfig;

@@ -31,6 +31,11 @@ pub struct Args {
     /// each (comma-separated) [default: the configuration's, gemm].
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     pub conv: Vec<ConvAlgorithm>,
+    /// Rewrite the decode block of this markdown file (the README's, between
+    /// `<!-- bench-decode:begin -->` and `<!-- bench-decode:end -->`) from this run: the
+    /// `slice` preset's decode beside IPCA's.
+    #[arg(long, value_name = "FILE")]
+    pub update_readme: Option<std::path::PathBuf>,
     /// Also time the network of this training configuration (JSON, as `train` saves it).
     #[arg(long, value_name = "FILE")]
     pub config: Option<std::path::PathBuf>,
@@ -57,6 +62,11 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     if !args.conv.is_empty() {
         runs = with_conv(runs, &args.conv)?;
     }
+    if args.update_readme.is_some() && !runs.iter().any(|(name, _)| name == Preset::Slice.name()) {
+        anyhow::bail!(
+            "--update-readme writes the slice preset's decode time: run with --preset slice"
+        );
+    }
     println!("device {kind}, k = {}", args.k);
     let ipca = ipca_decode(args.k, args.decodes)?;
     println!(
@@ -64,6 +74,7 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         "preset", "batch", "train s/step", "train s/sample", "decode net s", "decode all s"
     );
     let mut per_sample = Vec::new();
+    let mut slice_decode = None;
     for (name, config) in runs {
         let batch = args.batch.unwrap_or(config.batch_size);
         let train =
@@ -88,6 +99,9 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
             ipca.median(),
             all.median() / ipca.median()
         );
+        if name == Preset::Slice.name() {
+            slice_decode = Some(all.median());
+        }
         per_sample.push((name, step / batch as f64));
     }
     if let [(a, ta), (b, tb)] = &per_sample[..] {
@@ -106,7 +120,33 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         args.k,
         ipca.median()
     );
+    if let (Some(readme), Some(deep)) = (&args.update_readme, slice_decode) {
+        let block = decode_block(args.k, deep, ipca.median(), &args);
+        crate::readme_block::update_file(readme, DECODE_BEGIN, DECODE_END, &block)?;
+        println!("wrote the decode block of {}", readme.display());
+    }
     Ok(())
+}
+
+/// Marker lines of the block `--update-readme` writes.
+pub const DECODE_BEGIN: &str = "<!-- bench-decode:begin -->";
+pub const DECODE_END: &str = "<!-- bench-decode:end -->";
+
+/// The README's decode row, from one run: the `slice` preset's decode beside IPCA's at `k`,
+/// the paper's claim, and the command that wrote it.
+fn decode_block(k: usize, deep: f64, ipca: f64, args: &Args) -> String {
+    let threads = rayon::current_num_threads();
+    format!(
+        "| Decoding one full table, k = {k} | the paper's claim | measured here: DeepBRDF \
+         (`slice`) / IPCA | command |\n| --- | --- | --- | --- |\n| latent or coefficients to \
+         a full MERL table | DeepBRDF 0.3 s, IPCA 0.15 s (a GPU; 2.0x) | {deep:.3} s / \
+         {ipca:.3} s (**{ratio:.2}x**; medians of {decodes}, {threads} threads, one run) | \
+         `RAYON_NUM_THREADS={threads} experiments bench model --preset slice --k {k} --steps \
+         {steps} --decodes {decodes} --update-readme README.md` |\n",
+        ratio = deep / ipca,
+        decodes = args.decodes,
+        steps = args.steps,
+    )
 }
 
 /// Each convolutional run once per algorithm of `conv`, named `NAME/ALGORITHM`; the others
