@@ -3,6 +3,7 @@
 use deepbrdf_data::Progress;
 
 pub mod convert;
+mod cpu_time;
 pub mod edit;
 pub mod io;
 pub mod lookup;

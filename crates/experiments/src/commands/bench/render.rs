@@ -2,6 +2,7 @@
 //! tabulated MERL material under sun and sky at 64 spp in under 0.5 s on 2 cores). Prints MERL
 //! lookups per second, images per second, and the cost of the tabulated material relative to an
 //! analytic one measured in the same run.
+use super::cpu_time::cpu_seconds;
 use crate::args::data::CacheArg;
 use anyhow::Context;
 use deepbrdf_data::dataset::load_material;
@@ -57,15 +58,6 @@ impl Brdf for Counting<'_> {
     fn pdf(&self, wi: Vec3, wo: Vec3) -> f64 {
         self.inner.pdf(wi, wo)
     }
-}
-
-/// CPU time (user + system) of this process so far, in seconds, from `/proc/self/stat`
-/// (Linux; clock ticks assumed to be the usual 1/100 s). `None` elsewhere.
-pub(crate) fn cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    let fields: Vec<&str> = stat.rsplit_once(')')?.1.split_whitespace().collect();
-    let ticks = fields.get(11)?.parse::<f64>().ok()? + fields.get(12)?.parse::<f64>().ok()?;
-    Some(ticks / 100.0)
 }
 
 /// Timings of `repeats` calls (after one warm-up call).

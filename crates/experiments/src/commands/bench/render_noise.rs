@@ -12,7 +12,7 @@
 //! noise is then an estimate from a few numbers (cg_sunflower under sun and sky, 64 spp, three
 //! pairs of one renderer: 0.194, 0.085, 0.062). The `top` column says which share of the pooled
 //! squared difference comes from the 0.1% of pixels with the largest differences.
-use super::render::cpu_seconds;
+use super::cpu_time::cpu_seconds;
 use crate::args::data::CacheArg;
 use anyhow::Context;
 use deepbrdf_data::dataset::load_material;

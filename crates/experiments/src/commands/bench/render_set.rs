@@ -49,10 +49,10 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let dir = tempfile::tempdir()?;
     let load = |spec: &str| load_material(spec, &cache).map(|(_, t)| t).map_err(|e| e.to_string());
     let start = Instant::now();
-    let cpu0 = super::render::cpu_seconds().unwrap_or(0.0);
+    let cpu0 = super::cpu_time::cpu_seconds().unwrap_or(0.0);
     let n = set.render_missing(dir.path(), &load, progress)?;
     let (wall, cpu) =
-        (start.elapsed().as_secs_f64(), super::render::cpu_seconds().unwrap_or(0.0) - cpu0);
+        (start.elapsed().as_secs_f64(), super::cpu_time::cpu_seconds().unwrap_or(0.0) - cpu0);
     println!(
         "render set: {n} images of {} materials, {}x{} px, {} spp: {wall:.2} s wall, {cpu:.2} s \
          CPU -> {:.2} images/s ({:.3} s of CPU per image); 2000 images would take ~{:.0} s",
