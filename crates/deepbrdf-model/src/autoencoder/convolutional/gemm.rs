@@ -66,20 +66,11 @@ pub(crate) fn conv2d(conv: &Conv2d, x: Tensor<4>) -> Tensor<4> {
     let taps = kh * kw;
     let weight = conv.weight.val().reshape([1, c_out, c_in * taps]); // [1, c_out, c_in*kh*kw]
     let padded = pad(x, top, bottom, left, right); // [batch, c_in, hp, wp]
-    let columns = |x: Tensor<4>| {
-        let shifted: Vec<Tensor<4>> = (0..kh)
-            .flat_map(|i| (0..kw).map(move |j| (i, j)))
-            .map(|(i, j)| {
-                x.clone()
-                    .slice(s![.., .., i..i + sh * (ho - 1) + 1;sh, j..j + sw * (wo - 1) + 1;sw])
-            }) // each [b, c_in, ho, wo]
-            .collect();
-        let b = x.dims()[0];
-        Tensor::stack::<5>(shifted, 2).reshape([b, c_in * taps, ho * wo]) // [b, c_in*kh*kw, ho*wo]
-    };
-    let per_sample = c_in * taps * ho * wo;
-    let y = in_chunks(padded, per_sample.max(c_out * ho * wo), |x| {
-        weight.clone().matmul(columns(x)) // [b, c_out, ho*wo]
+    let (tap_rows, tap_cols): (Vec<usize>, Vec<usize>) = ((0..kh).collect(), (0..kw).collect());
+    let per_sample = (c_in * taps).max(c_out) * ho * wo;
+    let y = in_chunks(padded, per_sample, |x| {
+        let columns = columns(x, &tap_rows, &tap_cols, [ho, wo], [sh, sw]); // [b, c_in*kh*kw, ho*wo]
+        weight.clone().matmul(columns) // [b, c_out, ho*wo]
     });
     let y = y.reshape([batch, c_out, ho, wo]); // [batch, c_out, ho, wo]
     with_bias(y, conv.bias.as_ref())
@@ -134,17 +125,13 @@ pub(crate) fn conv_transpose2d(deconv: &ConvTranspose2d, x: Tensor<4>) -> Tensor
         .reshape([1, c_out * phases, c_in * window]); // [1, c_out*phases, c_in*window]
 
     let padded = pad(x, rows.before, rows.after, cols.before, cols.after); // [batch, c_in, ., .]
-    let columns = |x: Tensor<4>| {
-        let shifted: Vec<Tensor<4>> = (0..dh)
-            .flat_map(|i| (0..dw).map(move |j| (i, j)))
-            .map(|(i, j)| (rows.start(i), cols.start(j)))
-            .map(|(i, j)| x.clone().slice(s![.., .., i..i + mh, j..j + mw])) // each [b, c_in, mh, mw]
-            .collect();
-        let b = x.dims()[0];
-        Tensor::stack::<5>(shifted, 2).reshape([b, c_in * window, mh * mw]) // [b, c_in*window, mh*mw]
-    };
+    let window_rows: Vec<usize> = (0..dh).map(|i| rows.start(i)).collect();
+    let window_cols: Vec<usize> = (0..dw).map(|j| cols.start(j)).collect();
     let per_sample = (c_in * window).max(c_out * phases) * mh * mw;
-    let y = in_chunks(padded, per_sample, |x| weight.clone().matmul(columns(x))); // [batch, c_out*phases, mh*mw]
+    let y = in_chunks(padded, per_sample, |x| {
+        let columns = columns(x, &window_rows, &window_cols, [mh, mw], [1, 1]); // [b, c_in*window, mh*mw]
+        weight.clone().matmul(columns) // [b, c_out*phases, mh*mw]
+    });
     let y = y
         .reshape([batch, c_out, rows.stride, cols.stride, mh, mw])
         .permute([0, 1, 4, 2, 5, 3]) // [batch, c_out, mh, sy, mw, sx]
@@ -212,6 +199,31 @@ impl Phases {
         let k = r as isize + self.padding as isize - self.stride as isize * d;
         usize::try_from(k).ok().filter(|&k| k < self.kernel)
     }
+}
+
+/// The columns of a convolution over `x`: for each pair of a row start in `rows` and a
+/// column start in `cols`, the `size` pixels from there `stride` apart, stacked after each
+/// channel's (the order of a `[c_out, c_in, kh, kw]` weight flattened).
+///
+/// # Shapes
+/// - x: `[b, c_in, h, w]` -> `[b, c_in * rows * cols, size[0] * size[1]]`
+fn columns(
+    x: Tensor<4>,
+    rows: &[usize],
+    cols: &[usize],
+    size: [usize; 2],
+    stride: [usize; 2],
+) -> Tensor<3> {
+    let [b, c_in, _, _] = x.dims();
+    let ([h, w], [sh, sw]) = (size, stride);
+    let shifted: Vec<Tensor<4>> = rows
+        .iter()
+        .flat_map(|&i| cols.iter().map(move |&j| (i, j)))
+        .map(|(i, j)| {
+            x.clone().slice(s![.., .., i..i + sh * (h - 1) + 1;sh, j..j + sw * (w - 1) + 1;sw])
+        })
+        .collect(); // each [b, c_in, h, w]
+    Tensor::stack::<5>(shifted, 2).reshape([b, c_in * rows.len() * cols.len(), h * w])
 }
 
 /// Zero padding of the last two axes (top, bottom, left, right); none is a no-op.

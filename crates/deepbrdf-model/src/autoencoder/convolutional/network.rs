@@ -123,11 +123,6 @@ impl Convolutional {
         Self { conv, ..self }
     }
 
-    /// How the network computes its convolutions.
-    pub fn conv(&self) -> ConvAlgorithm {
-        self.conv
-    }
-
     /// Encoder f (eq. 2) on centred, masked inputs.
     ///
     /// # Shapes

@@ -107,12 +107,7 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     if let [(a, ta), (b, tb)] = &per_sample[..] {
         println!("training cost per sample: {b} / {a} = {:.1}x", tb / ta);
     }
-    for (name, step) in &per_sample {
-        let Some(base) = name.strip_suffix("/gemm") else { continue };
-        if let Some((_, direct)) = per_sample.iter().find(|(n, _)| *n == format!("{base}/direct")) {
-            println!("{base} training step: direct / gemm = {:.2}x (same run)", direct / step);
-        }
-    }
+    print_conv_ratios(&per_sample);
     println!("(medians; decode = network + inverse layout + inverse eq. (1) to a full MERL table)");
     println!(
         "IPCA decode at k = {}: {:.4} s (k coefficients -> the basis' row -> the inverse \
@@ -129,8 +124,8 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
 }
 
 /// Marker lines of the block `--update-readme` writes.
-pub const DECODE_BEGIN: &str = "<!-- bench-decode:begin -->";
-pub const DECODE_END: &str = "<!-- bench-decode:end -->";
+const DECODE_BEGIN: &str = "<!-- bench-decode:begin -->";
+const DECODE_END: &str = "<!-- bench-decode:end -->";
 
 /// The README's decode row, from one run: the `slice` preset's decode beside IPCA's at `k`,
 /// the paper's claim, and the command that wrote it.
@@ -147,6 +142,16 @@ fn decode_block(k: usize, deep: f64, ipca: f64, args: &Args) -> String {
         decodes = args.decodes,
         steps = args.steps,
     )
+}
+
+/// `NAME training step: direct / gemm = X` for each run timed both ways (`--conv direct,gemm`).
+fn print_conv_ratios(per_sample: &[(String, f64)]) {
+    for (name, step) in per_sample {
+        let Some(base) = name.strip_suffix("/gemm") else { continue };
+        if let Some((_, direct)) = per_sample.iter().find(|(n, _)| *n == format!("{base}/direct")) {
+            println!("{base} training step: direct / gemm = {:.2}x (same run)", direct / step);
+        }
+    }
 }
 
 /// Each convolutional run once per algorithm of `conv`, named `NAME/ALGORITHM`; the others
