@@ -327,3 +327,68 @@ fn train_within_a_time_limit_writes_the_epochs_done_and_resumes_to_the_end() {
         util::assert_clean_failure(&out, "--time-limit");
     }
 }
+
+#[test]
+fn highlights_reports_each_stage_of_a_model_trained_with_a_flattened_reference() {
+    use deepbrdf_data::mapping::MedianReference;
+    use deepbrdf_model::autoencoder::Architecture;
+    let dir = tempfile::tempdir().unwrap();
+    let data = util::write_data(dir.path(), 3);
+    // The tiny slice network with the highlight's centre weighted and the eq. (1) reference's
+    // peak flattened below 10 deg.
+    let mut config = util::tiny_train_config();
+    if let Architecture::Slice(layers) = &mut config.model.architecture {
+        layers.centre_emphasis = Some(5.0);
+        layers.reference_flat_below_deg = Some(10.0);
+    }
+    let path = dir.path().join("centre.json");
+    config.save(&path).unwrap();
+    let model = dir.path().join("run");
+    util::run_ok(
+        dir.path(),
+        &["train", "--config", &s(&path), "--data", &s(&data), "--out", &s(&model)],
+    );
+    // The model keeps the reference it was trained with: the training median, flattened.
+    let tables: Vec<_> =
+        (0..3).map(|i| read_merl(data.join(format!("m{i}.binary"))).unwrap()).collect();
+    let refs: Vec<&_> = tables.iter().collect();
+    let flat = MedianReference::from_tables(&refs).unwrap().flattened_below(10.0);
+    let device = deepbrdf_model::DeviceKind::default_kind().unwrap().device().unwrap();
+    let loaded = deepbrdf_model::DeepBrdf::load(&model, &device).unwrap();
+    assert!(loaded.reference() == &flat, "the saved reference is not the flattened median");
+    // One row per stage, each counting at most the 3 materials.
+    let out = util::run_ok(dir.path(), &["highlights", "--model", &s(&model), "--data", &s(&data)]);
+    let text = util::stdout(&out);
+    assert!(text.contains("either (of 3)"), "{text}");
+    for stage in ["basis", "linear", "encoded", "refined"] {
+        let row = text.lines().find(|l| l.starts_with(&format!("| {stage} |"))).unwrap_or_default();
+        let counts: Vec<usize> = row.split('|').filter_map(|c| c.trim().parse().ok()).collect();
+        assert!(counts.len() == 3 && counts.iter().all(|&c| c <= 3), "{stage}: {row}");
+    }
+    // --profile: the reference, the original and the four stages at each theta_h sample.
+    let m0 = s(&data.join("m0.binary"));
+    let out = util::run_ok(dir.path(), &["highlights", "--model", &s(&model), "--profile", &m0]);
+    let text = util::stdout(&out);
+    let row = text.lines().find(|l| l.starts_with("| 0 |")).unwrap_or_default();
+    assert_eq!(row.split('|').filter(|c| c.trim().parse::<f64>().is_ok()).count(), 8, "{text}");
+    // A model that is not a slice network has no stages: a clear error.
+    let paper = dir.path().join("paper.json");
+    let mut conv = TrainConfig::paper(2).with_epochs(1).with_batch_size(2);
+    conv.model = deepbrdf_model::AutoencoderConfig::convolutional(
+        2,
+        deepbrdf_model::autoencoder::ConvolutionalConfig::new()
+            .with_projection(Some(1))
+            .with_encoder_channels([1, 1, 1])
+            .with_residual_blocks(0)
+            .with_decoder_channels([1, 1]),
+    );
+    conv.save(&paper).unwrap();
+    let conv_model = dir.path().join("conv");
+    util::run_ok(
+        dir.path(),
+        &["train", "--config", &s(&paper), "--data", &s(&data), "--out", &s(&conv_model)],
+    );
+    let out =
+        util::run_in(dir.path(), &["highlights", "--model", &s(&conv_model), "--data", &s(&data)]);
+    util::assert_clean_failure(&out, "slice");
+}

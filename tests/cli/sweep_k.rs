@@ -77,9 +77,9 @@ fn sweep_k_writes_results_and_reuses_trained_models() {
         assert!(out.join(f).is_file(), "{f} missing");
     }
     let results = std::fs::read_to_string(out.join("results.csv")).unwrap();
-    // 3 methods x 2 k x 3 materials x 3 measures (mapped, cosine-weighted, image RelAE), plus
-    // the header.
-    assert_eq!(results.lines().count(), 1 + 3 * 2 * 3 * 3, "{results}");
+    // 3 methods x 2 k x 3 materials x 5 measures (mapped, cosine-weighted, image RelAE, dark
+    // holes, tinted centres), plus the header.
+    assert_eq!(results.lines().count(), 1 + 3 * 2 * 3 * 5, "{results}");
     assert!(out.join("per_material_image_relae.svg").is_file());
     let training = std::fs::read_to_string(out.join("training.csv")).unwrap();
     assert_eq!(training.lines().filter(|l| l.contains(",trained,")).count(), 2, "{training}");

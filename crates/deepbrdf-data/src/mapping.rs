@@ -11,7 +11,7 @@
 pub mod file;
 
 use crate::error::{DataError, Result};
-use crate::merl::{MerlTable, CELLS, INVALID_VALUE, VALUES};
+use crate::merl::{MerlTable, CELLS, INVALID_VALUE, N_PHI_D, N_THETA_D, N_THETA_H, VALUES};
 use rayon::prelude::*;
 
 /// eps of eq. (1): a small constant that avoids division by zero.
@@ -111,6 +111,34 @@ impl MedianReference {
     /// The reference values, [`VALUES`] long, channel-major MERL order.
     pub fn values(&self) -> &[f32] {
         &self.values
+    }
+
+    /// The reference with its peak at the mirror direction flattened: at every theta_h below
+    /// `theta_h_deg`, each value is capped by the value of the same (theta_d, phi_d, channel)
+    /// at the first theta_h sample at or above it. The median over a collection of glossy
+    /// materials peaks sharply at theta_h ~ 0; eq. (1) then divides a material with a weaker
+    /// highlight by that peak, so its highlight is a dip in the mapped space whose errors come
+    /// back multiplied by the peak (`d rho / d y = rho + rho_ref + eps`): a dark or tinted dot.
+    /// Capped, a highlight above the cap maps logarithmically, as the rest of the table does.
+    pub fn flattened_below(&self, theta_h_deg: f64) -> Self {
+        let edge = (0..N_THETA_H)
+            .find(|&h| crate::merl::grid::theta_h_of(h).to_degrees() >= theta_h_deg)
+            .unwrap_or(N_THETA_H);
+        let mut values = self.values.clone();
+        if edge == 0 || edge == N_THETA_H {
+            return Self { values };
+        }
+        let per_h = N_THETA_D * N_PHI_D;
+        for channel in values.chunks_exact_mut(CELLS) {
+            let (below, rest) = channel.split_at_mut(edge * per_h);
+            let cap = &rest[..per_h];
+            for row in below.chunks_exact_mut(per_h) {
+                for (v, c) in row.iter_mut().zip(cap) {
+                    *v = v.min(*c);
+                }
+            }
+        }
+        Self { values }
     }
 
     /// Eq. (1) applied to every value of `table`: [`VALUES`] mapped values, channel-major MERL
@@ -322,5 +350,42 @@ mod tests {
         assert!(MedianReference::from_values(v.clone()).is_err());
         v[3] = f32::INFINITY;
         assert!(MedianReference::from_values(v).is_err());
+    }
+
+    #[test]
+    fn a_flattened_reference_caps_the_peak_below_the_angle_and_keeps_the_rest() {
+        use crate::merl::grid::{cell_index, theta_h_of};
+        // A reference peaked at theta_h = 0, falling with theta_h, and different per colour
+        // and phi_d.
+        let values: Vec<f32> = (0..VALUES)
+            .map(|i| {
+                let (c, cell) = (i / CELLS, i % CELLS);
+                let (h, dp) = (cell / (N_THETA_D * N_PHI_D), cell % (N_THETA_D * N_PHI_D));
+                (c + 1) as f32 * (1.0 + (dp % 7) as f32) * (10.0 / (1.0 + h as f32))
+            })
+            .collect();
+        let reference = MedianReference::from_values(values).unwrap();
+        let flat = reference.flattened_below(10.0);
+        let edge = (0..N_THETA_H).find(|&h| theta_h_of(h).to_degrees() >= 10.0).unwrap();
+        assert!(edge > 20 && edge < 40, "{edge}");
+        for c in 0..3 {
+            for (d, p) in [(0, 0), (17, 33), (89, 179)] {
+                let at =
+                    |r: &MedianReference, h: usize| r.values()[c * CELLS + cell_index(h, d, p)];
+                for h in 0..edge {
+                    assert_eq!(at(&flat, h), at(&reference, edge), "h {h}");
+                }
+                for h in edge..N_THETA_H {
+                    assert_eq!(at(&flat, h), at(&reference, h));
+                }
+            }
+        }
+        // Below the angle a value under the cap stays; no angle or 0 deg changes nothing.
+        let mut dip = reference.values().to_vec();
+        dip[cell_index(0, 5, 5)] = 0.0;
+        let dip = MedianReference::from_values(dip).unwrap().flattened_below(10.0);
+        assert_eq!(dip.values()[cell_index(0, 5, 5)], 0.0);
+        assert_eq!(reference.flattened_below(0.0), reference);
+        assert_eq!(reference.flattened_below(95.0), reference);
     }
 }

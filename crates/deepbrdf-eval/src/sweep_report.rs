@@ -62,6 +62,18 @@ impl SweepReport<'_> {
         measures.sort_by_key(|&measure| measure != Measure::ImageRelae);
         for measure in measures {
             let label = measure.label();
+            if measure.counts() {
+                let c = |method: &str| self.results.count(method, k0, measure);
+                if let (Some(d), Some(p), Some(i)) = (c(NAME), c("PCA"), c("IPCA")) {
+                    let n = self.results.materials().len();
+                    let _ = writeln!(
+                        s,
+                        "- k = {k0}, {label}: {NAME} {d} vs PCA {p} and IPCA {i} (of {n}): {NAME} has {}.",
+                        if d <= p && d <= i { "no more than either" } else { "more than PCA or IPCA" }
+                    );
+                }
+                continue;
+            }
             let (Some(d), Some(p), Some(i)) =
                 (m(NAME, k0, measure), m("PCA", k0, measure), m("IPCA", k0, measure))
             else {
@@ -315,6 +327,26 @@ mod tests {
         };
         let claims = report.claims();
         assert!(claims.contains("DeepBRDF/PCA 0.500, DeepBRDF/IPCA 0.333): DeepBRDF is below both"));
+        // A defect is compared as a count of materials.
+        let mut holed = results.clone();
+        holed.measures.push(Measure::DarkHole);
+        for (method, holes) in [(NAME, 2), ("PCA", 0), ("IPCA", 1)] {
+            for (i, material) in ["a", "b"].into_iter().enumerate() {
+                holed.records.push(Record {
+                    method: method.into(),
+                    k: 10,
+                    fold: i,
+                    material: material.into(),
+                    measure: Measure::DarkHole,
+                    value: f64::from(u8::from(i < holes)),
+                });
+            }
+        }
+        let claims_holed = SweepReport { results: &holed, ..report }.claims();
+        assert!(
+            claims_holed.contains("a dark hole at the highlight: DeepBRDF 2 vs PCA 0 and IPCA 1 (of 2): DeepBRDF has more than PCA or IPCA."),
+            "{claims_holed}"
+        );
         assert!(claims.contains("vs PCA and IPCA at k = 20: 1.0000e0 vs 5.0000e-1 and 4.0000e0 (below IPCA, above PCA)"), "{claims}");
         assert!(claims.contains("1/3 of the slices, k = 10: DeepBRDF 1.0000e0 vs nearest-slice fill 2.0000e0: DeepBRDF is better."), "{claims}");
         assert!(report.protocol().starts_with("**Held out**: 2-fold over two materials"));

@@ -53,6 +53,21 @@ impl DeepBrdf {
         self
     }
 
+    /// The network.
+    pub(crate) fn network(&self) -> &Autoencoder {
+        &self.model
+    }
+
+    /// The device the network runs on.
+    pub(crate) fn device(&self) -> &Device {
+        &self.device
+    }
+
+    /// The MERL grid's validity mask.
+    pub(crate) fn grid_mask(&self) -> &'static [bool] {
+        self.grid_mask
+    }
+
     /// k, the number of latent values.
     pub fn k(&self) -> usize {
         self.model.latent()

@@ -38,7 +38,7 @@ pub fn fit(
     device: &Device,
 ) -> Result<DeepBrdf> {
     config.validate()?;
-    let reference = MedianReference::from_tables(tables)?;
+    let reference = config.model.mapping_reference(&MedianReference::from_tables(tables)?);
     let mut set = TrainingSet::from_tables(label, names, tables, &reference)?;
     if let Some(streamed) = streamed {
         set = set.with_streamed(streamed)?;

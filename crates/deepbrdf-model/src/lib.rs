@@ -26,6 +26,7 @@ pub mod recovery;
 pub mod regressor;
 pub mod seeded;
 pub mod shipped;
+pub mod stages;
 pub mod streamed;
 pub mod timing;
 pub mod train;

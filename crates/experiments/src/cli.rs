@@ -47,6 +47,9 @@ pub enum Command {
     Decode(commands::decode::Args),
     /// Encode and decode a BRDF, optionally from 1/3 or 1/9 of its slices (Fig. 2).
     Reconstruct(commands::reconstruct::Args),
+    /// Where a `slice` model's decodes lose the highlight: dark holes and tinted centres at
+    /// each stage of the reconstruction (basis, linear path, encoder, refined encoding).
+    Highlights(commands::highlights::Args),
     /// The main job: DeepBRDF, PCA and IPCA at each k (Figs. 2, 3 and 7), tables and plots.
     SweepK(commands::sweep_k::Args),
     /// Render a material (a MERL .binary file or a bundled material) to PNG and EXR.

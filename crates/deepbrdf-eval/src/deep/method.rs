@@ -155,7 +155,7 @@ impl DeepMethod {
         train: &FoldTraining<'_>,
         k: usize,
         cache: &Arc<InputCache>,
-        set: &mut Option<MappedSet>,
+        set: &mut Option<(MedianReference, MappedSet)>,
         progress: &dyn Progress,
     ) -> Result<Box<dyn Codec>> {
         let names = train.names;
@@ -171,18 +171,26 @@ impl DeepMethod {
         let (model, origin) = match self.load_finished(&dir, &config, names)? {
             Some(model) => (model, FitOrigin::Loaded),
             None => {
-                let mapped = match set {
-                    Some(mapped) => mapped,
-                    None => set.insert(
-                        MappedSet::from_table_set(
+                // The configuration's eq. (1) reference from the fold's median; the fold's
+                // mapped set is rebuilt only if another k asks for another reference.
+                let reference = config.model.mapping_reference(train.reference);
+                if set.as_ref().is_some_and(|(r, _)| *r != reference) {
+                    *set = None;
+                }
+                let (reference, mapped) = match set {
+                    Some((reference, mapped)) => (&*reference, mapped),
+                    None => {
+                        let mapped = MappedSet::from_table_set(
                             &self.label,
                             names,
                             train.set,
                             train.indices,
-                            train.reference,
+                            &reference,
                         )
-                        .map_err(|e| model_error(&dir, e))?,
-                    ),
+                        .map_err(|e| model_error(&dir, e))?;
+                        let (r, m) = set.insert((reference, mapped));
+                        (&*r, m)
+                    }
                 };
                 let model = deepbrdf_model::train_within(
                     &config,
@@ -196,7 +204,7 @@ impl DeepMethod {
                 .and_then(|trained| {
                     let artifact = ModelArtifact::from_trained(
                         trained,
-                        train.reference.clone(),
+                        reference.clone(),
                         &self.label,
                         names,
                         &self.device,

@@ -4,6 +4,7 @@
 //! the network input each BRDF is mapped to once ([`MappedInput`]).
 
 mod codec;
+pub mod highlights;
 mod mapped_input;
 mod method;
 

@@ -15,6 +15,11 @@
 //!   minus that channel's floor;
 //! - a **dark hole**: the lobe at theta_h ~ 0 (the first sample) below 60% of the lobe's maximum
 //!   within theta_h <= 15 deg, where the original's was not;
+//! - the **centre's colour**: the RGB chromaticity of the profile's mean over theta_h bins 0-2
+//!   (the highlight's centre as a renderer shows it, floor included); a **tinted centre**: a
+//!   reconstruction whose centre colour is more than 0.10 (Euclidean, in chromaticity) from the
+//!   original's. A dark hole or a tinted centre is a wrong highlight: the decoding issue counts
+//!   both;
 //! - the **bars** of an edit: roughness x2 widens the HWHM >= 1.4x, roughness x0.5 narrows it to
 //!   <= 0.75x, diffuse x0.5 leaves the floor at 0.35-0.65x with the peak within 25% and its
 //!   colour within 20%; and no edit leaves a dark hole.
@@ -37,6 +42,10 @@ pub const FLOOR_MIN_THETA_H_DEG: f64 = 45.0;
 pub const HOLE_FRACTION: f64 = 0.6;
 /// The theta_h window (degrees) of the maximum a dark hole is judged against.
 pub const HOLE_WINDOW_DEG: f64 = 15.0;
+/// The highlight's centre: the theta_h bins below this index.
+pub const CENTRE_BINS: usize = 3;
+/// A tinted centre: the centre's chromaticity moved by more than this (Euclidean).
+pub const TINT_SHIFT: f64 = 0.10;
 /// Roughness x2 passes when the HWHM grows by at least this factor.
 pub const WIDEN_MIN_RATIO: f64 = 1.4;
 /// Roughness x0.5 passes when the HWHM shrinks to at most this factor.
@@ -87,6 +96,9 @@ pub struct Lobe {
     pub centre: f64,
     /// The lobe's maximum over the samples with theta_h <= 15 deg.
     pub near_max: f64,
+    /// RGB chromaticity of the profile's mean over theta_h bins `0..CENTRE_BINS` (floor
+    /// included); `None` when none of those bins has a valid cell or their sum is not positive.
+    pub centre_colour: Option<[f64; 3]>,
 }
 
 impl Lobe {
@@ -134,7 +146,15 @@ impl Lobe {
             .filter(|(s, _)| s.theta_h_deg <= HOLE_WINDOW_DEG)
             .map(|(_, v)| *v)
             .fold(f64::NEG_INFINITY, f64::max);
+        let centre: Vec<&ProfileSample> =
+            profile.iter().filter(|s| s.theta_h < CENTRE_BINS).collect();
+        let centre_sum: [f64; 3] =
+            std::array::from_fn(|c| centre.iter().map(|s| s.rgb[c]).sum::<f64>());
+        let total: f64 = centre_sum.iter().sum();
+        let centre_colour =
+            (total > 0.0 && total.is_finite()).then(|| centre_sum.map(|v| v / total));
         Ok(Self {
+            centre_colour,
             floor,
             floor_rgb,
             peak,
@@ -257,6 +277,25 @@ pub fn compare(original: &Lobe, edited: &Lobe) -> LobeComparison {
 /// Whether `edited` has a dark centre at theta_h ~ 0 that `original` does not.
 pub fn dark_hole(original: &Lobe, edited: &Lobe) -> bool {
     edited.has_dark_centre() && !original.has_dark_centre()
+}
+
+/// How far (Euclidean, in RGB chromaticity) the centre's colour of `other` is from
+/// `original`'s; NaN where either is undefined.
+pub fn centre_shift(original: &Lobe, other: &Lobe) -> f64 {
+    match (original.centre_colour, other.centre_colour) {
+        (Some(o), Some(e)) => o.iter().zip(&e).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt(),
+        _ => f64::NAN,
+    }
+}
+
+/// Whether the highlight's centre of `other` changed colour: [`centre_shift`] above
+/// [`TINT_SHIFT`]. A centre that vanished (no positive sum) where the original's is defined
+/// counts as tinted.
+pub fn tinted_centre(original: &Lobe, other: &Lobe) -> bool {
+    match (original.centre_colour, other.centre_colour) {
+        (Some(_), None) => true,
+        _ => centre_shift(original, other) > TINT_SHIFT,
+    }
 }
 
 /// The bar an edit is held to (beside "no dark hole", which every edit is held to).

@@ -22,8 +22,8 @@ pub mod stretch;
 pub use analytic::{analytic_edit, carry_edit};
 pub use known::{KnownEdit, KnownTally};
 pub use lobe::{
-    compare, dark_hole, judge_edit, verdict, BarCount, EditLobe, Lobe, LobeBar, LobeComparison,
-    LobeTally, LobeVerdict,
+    centre_shift, compare, dark_hole, judge_edit, tinted_centre, verdict, BarCount, EditLobe, Lobe,
+    LobeBar, LobeComparison, LobeTally, LobeVerdict,
 };
 pub use measures::{
     coefficient_of_variation, directional_albedo, edit_outcome, is_monotone, plausibility,

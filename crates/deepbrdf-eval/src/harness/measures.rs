@@ -1,6 +1,7 @@
 //! Error measures between an original table and its reconstruction, each over the cells valid
 //! in the original only (invalid cells carry no measurement).
 
+use crate::editing::{dark_hole, tinted_centre, Lobe};
 use crate::error::{EvalError, Result};
 use deepbrdf_data::mapping::{log_relative, MedianReference};
 use deepbrdf_data::merl::{grid, CELLS, VALUES};
@@ -23,6 +24,14 @@ pub enum Measure {
     /// ([`crate::metrics::ImageRelae`] with its default scene). Costs two renders (~0.15 s of
     /// CPU each), so it is opt-in.
     ImageRelae,
+    /// 1 where the reconstruction's highlight has a dark centre that the original's has not
+    /// ([`crate::editing::dark_hole`]: the specular profile at theta_h ~ 0 below 60% of its
+    /// maximum within 15 deg), else 0; summed, the number of materials decoded with a dark dot
+    /// at the highlight.
+    DarkHole,
+    /// 1 where the highlight's centre changed colour ([`crate::editing::tinted_centre`]: its
+    /// chromaticity over theta_h bins 0-2, theta_d < 15 deg, moved by more than 0.10), else 0.
+    TintedCentre,
 }
 
 // All measures, in table order, by their machine names (CSV files, the command line).
@@ -30,11 +39,21 @@ deepbrdf_data::named_enum!(Measure {
     MappedMse => "mapped_mse",
     CosRmse => "cos_rmse",
     ImageRelae => "image_relae",
+    DarkHole => "dark_hole",
+    TintedCentre => "tinted_centre",
 });
 
 impl Measure {
-    /// The measures computed on the tables alone (fast; the default).
+    /// The error measures computed on the tables alone (fast; the default).
     pub const TABLE: [Measure; 2] = [Measure::MappedMse, Measure::CosRmse];
+    /// The highlight's defects, counted per material.
+    pub const HIGHLIGHT: [Measure; 2] = [Measure::DarkHole, Measure::TintedCentre];
+
+    /// Whether the measure is a 0/1 defect whose sum over materials is reported (a count), not
+    /// a mean error.
+    pub fn counts(self) -> bool {
+        matches!(self, Self::DarkHole | Self::TintedCentre)
+    }
 
     /// Whether the measure renders images (not computed by [`Yardstick::measure`]).
     pub fn renders(self) -> bool {
@@ -47,6 +66,8 @@ impl Measure {
             Self::MappedMse => "MSE in eq. (1) mapped space",
             Self::CosRmse => "cosine-weighted RMSE (1/sr)",
             Self::ImageRelae => "image-space RelAE (sphere, sun and sky)",
+            Self::DarkHole => "materials decoded with a dark hole at the highlight",
+            Self::TintedCentre => "materials decoded with a tinted highlight centre",
         }
     }
 }
@@ -55,7 +76,8 @@ impl FromStr for Measure {
     type Err = EvalError;
     fn from_str(s: &str) -> Result<Self> {
         Self::from_name(s).ok_or_else(|| {
-            EvalError::Invalid(format!("unknown measure '{s}' (mapped_mse, cos_rmse, image_relae)"))
+            let names: Vec<&str> = Self::ALL.iter().map(|m| m.name()).collect();
+            EvalError::Invalid(format!("unknown measure '{s}' ({})", names.join(", ")))
         })
     }
 }
@@ -74,6 +96,8 @@ pub struct Original<'a> {
     cells: Vec<u32>,
     /// Eq. (1) of the original at `cells`, channel-major (`c * cells.len() + m`).
     mapped: Vec<f32>,
+    /// The original's specular lobe; `None` where it cannot be read ([`Lobe::of`]).
+    lobe: Option<Lobe>,
 }
 
 /// Valid cells per parallel work item.
@@ -113,7 +137,7 @@ impl Yardstick {
                 }
             });
         }
-        Original { table, cells, mapped }
+        Original { table, cells, mapped, lobe: Lobe::of(table).ok() }
     }
 
     /// All `measures` of `recon` against `original`, in the given order. A reconstruction that
@@ -168,14 +192,32 @@ impl Yardstick {
             .collect();
         let (mapped_sum, cos_sum) = parts.iter().fold((0.0, 0.0), |x, y| (x.0 + y.0, x.1 + y.1));
         let count = (3 * n) as f64;
+        let defects = match measures.iter().any(|m| m.counts()) {
+            true => original.lobe.as_ref().map(|o| highlight_defects(o, recon)),
+            false => None,
+        };
+        let flag = |d: Option<(bool, bool)>, pick: fn((bool, bool)) -> bool| {
+            d.map_or(f64::NAN, |d| f64::from(u8::from(pick(d))))
+        };
         Ok(measures
             .iter()
             .map(|m| match m {
                 Measure::MappedMse => mapped_sum / count,
                 Measure::CosRmse => (cos_sum / count).sqrt(),
                 Measure::ImageRelae => f64::NAN, // rejected above
+                Measure::DarkHole => flag(defects, |d| d.0),
+                Measure::TintedCentre => flag(defects, |d| d.1),
             })
             .collect())
+    }
+}
+
+/// (dark hole, tinted centre) of `recon` against the original's lobe; a reconstruction whose
+/// lobe cannot be read has both.
+fn highlight_defects(original: &Lobe, recon: &MerlTable) -> (bool, bool) {
+    match Lobe::of(recon) {
+        Ok(lobe) => (dark_hole(original, &lobe), tinted_centre(original, &lobe)),
+        Err(_) => (true, true),
     }
 }
 
@@ -224,5 +266,36 @@ mod tests {
         // Order follows the request.
         let one = yardstick.measure(&original, &recon, &[Measure::CosRmse]).unwrap();
         assert_eq!(one, vec![got[1]]);
+    }
+
+    #[test]
+    fn a_dark_dot_at_the_highlight_counts_and_the_original_does_not() {
+        use deepbrdf_data::ggx::{ggx, Ggx};
+        use deepbrdf_data::merl::coords::HalfDiff;
+        use deepbrdf_data::testing::tabulate;
+        // Lambertian orange + a white GGX lobe; the same with the lobe cut out below `hole`
+        // degrees of theta_h.
+        let table = |hole: f64, blue: f64| {
+            let spec = Ggx { alpha: 0.08, f0: [0.04, 0.04, blue], diffuse: [0.0; 3] };
+            tabulate(move |wi, wo| {
+                let s = match HalfDiff::from_dirs(wi, wo).theta_h.to_degrees() < hole {
+                    true => [0.0; 3],
+                    false => ggx(&spec, wi, wo),
+                };
+                std::array::from_fn(|c| [0.5, 0.3, 0.1][c] / std::f64::consts::PI + s[c])
+            })
+        };
+        let a = table(0.0, 0.04);
+        let yardstick = Yardstick::from_training(&[&a]).unwrap();
+        let original = yardstick.original(&a);
+        let both = Measure::HIGHLIGHT;
+        assert_eq!(yardstick.measure(&original, &a, &both).unwrap(), vec![0.0, 0.0]);
+        // A dot: dark and, the floor's orange showing through, tinted.
+        let dot = yardstick.measure(&original, &table(3.0, 0.04), &both).unwrap();
+        assert_eq!(dot, vec![1.0, 1.0]);
+        // A blue-free highlight of the same brightness: tinted, not dark.
+        let yellow = yardstick.measure(&original, &table(0.0, 0.0), &both).unwrap();
+        assert_eq!(yellow, vec![0.0, 1.0]);
+        assert!(both.iter().all(|m| m.counts()) && !Measure::TABLE.iter().any(|m| m.counts()));
     }
 }

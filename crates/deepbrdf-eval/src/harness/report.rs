@@ -92,24 +92,35 @@ impl Results {
     }
 
     /// A markdown table per measure: one row per method, one column per k, the mean over
-    /// materials.
+    /// materials (for a defect count, [`Measure::counts`], the number of materials).
     pub fn summary_table(&self) -> String {
         let mut s = String::new();
         for &m in &self.measures {
-            let _ = writeln!(
-                s,
-                "Mean {} over {} evaluated materials:\n",
-                m.label(),
-                self.materials().len()
-            );
+            let n = self.materials().len();
+            let _ = match m.counts() {
+                true => writeln!(s, "Number of {} (of {n} evaluated materials):\n", m.label()),
+                false => writeln!(s, "Mean {} over {n} evaluated materials:\n", m.label()),
+            };
             s.push_str(&self.measure_table(m));
             s.push('\n');
         }
         s
     }
 
+    /// How many materials `method` at `k` has with the defect `measure` ([`Measure::counts`]);
+    /// `None` where it was not scored.
+    pub fn count(&self, method: &str, k: usize, measure: Measure) -> Option<usize> {
+        let values: Vec<f64> = self
+            .records
+            .iter()
+            .filter(|r| r.method == method && r.k == k && r.measure == measure)
+            .map(|r| r.value)
+            .collect();
+        (!values.is_empty()).then(|| values.iter().filter(|&&v| v > 0.5).count())
+    }
+
     /// The markdown table of one measure: one row per method, one column per k, the mean over
-    /// materials (`-` where a method was not scored at a k).
+    /// materials, or the count for a defect (`-` where a method was not scored at a k).
     pub fn measure_table(&self, measure: Measure) -> String {
         let mut s = String::from("| method |");
         self.ks.iter().for_each(|k| {
@@ -121,12 +132,11 @@ impl Results {
         for method in &self.methods {
             let _ = write!(s, "| {method} |");
             for &k in &self.ks {
-                match self.mean(method, k, measure) {
-                    Some(v) => {
-                        let _ = write!(s, " {v:.4e} |");
-                    }
-                    None => s.push_str(" - |"),
-                }
+                let cell = match measure.counts() {
+                    true => self.count(method, k, measure).map(|c| c.to_string()),
+                    false => self.mean(method, k, measure).map(|v| format!("{v:.4e}")),
+                };
+                let _ = write!(s, " {} |", cell.as_deref().unwrap_or("-"));
             }
             s.push('\n');
         }
@@ -160,7 +170,7 @@ impl Results {
             "\nEncoding + decoding + measuring: {:.1} s; whole run: {:.1} s.\n",
             self.eval_seconds, self.total_seconds
         );
-        for &m in &self.measures {
+        for &m in self.measures.iter().filter(|m| !m.counts()) {
             let _ = writeln!(s, "![{} vs k](error_vs_k_{}.svg)\n", m.label(), m.name());
             let _ = writeln!(s, "![{} per material](per_material_{}.svg)\n", m.label(), m.name());
         }
@@ -204,9 +214,10 @@ impl Results {
         self.write_charts(dir)
     }
 
-    /// Writes the plots into `dir`: error vs k and per material, one of each per measure.
+    /// Writes the plots into `dir`: error vs k and per material, one of each per error measure
+    /// (the defect counts are in the summary's tables).
     pub fn write_charts(&self, dir: &Path) -> Result<()> {
-        for &m in &self.measures {
+        for &m in self.measures.iter().filter(|m| !m.counts()) {
             write_chart(&self.error_vs_k_chart(m), &dir.join(format!("error_vs_k_{}", m.name())))?;
             write_panels(
                 &self.per_material_charts(m),
@@ -374,6 +385,30 @@ pub(crate) mod tests {
             eval_seconds: 1.0,
             total_seconds: 2.5,
         }
+    }
+
+    #[test]
+    fn defects_are_counted_per_method_and_k_and_drawn_in_no_chart() {
+        let mut results = fake_results(10);
+        for (i, r) in results.records.clone().iter().enumerate() {
+            if r.measure == Measure::MappedMse {
+                let hole = (r.method == "IPCA" && r.k == 5 && i % 3 == 0) as u8;
+                results.records.push(Record {
+                    measure: Measure::DarkHole,
+                    value: f64::from(hole),
+                    ..r.clone()
+                });
+            }
+        }
+        results.measures.push(Measure::DarkHole);
+        assert_eq!(results.count("PCA", 5, Measure::DarkHole), Some(0));
+        let holes = results.count("IPCA", 5, Measure::DarkHole).unwrap_or(0);
+        assert!(holes > 0 && holes < 10, "{holes}");
+        let table = results.measure_table(Measure::DarkHole);
+        assert!(table.contains(&format!("| IPCA | {holes} | 0 | 0 | 0 |")), "{table}");
+        let summary = results.summary_markdown();
+        assert!(summary.contains("Number of materials decoded with a dark hole at the highlight (of 10 evaluated materials)"), "{summary}");
+        assert!(!summary.contains("error_vs_k_dark_hole"), "{summary}");
     }
 
     #[test]

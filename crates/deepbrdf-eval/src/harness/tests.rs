@@ -63,7 +63,7 @@ fn in_sample_error_falls_with_k_and_vanishes_at_n_minus_1() {
             let bound = match m {
                 Measure::MappedMse => 1e-8,
                 Measure::CosRmse => 1e-5,
-                Measure::ImageRelae => unreachable!("not measured here"),
+                other => unreachable!("{other} is not measured here"),
             };
             assert!(e[2] < bound * e[0], "{method} {m}: k = n-1 gives {e:?}");
         }

@@ -11,6 +11,7 @@ use super::limits::MAX_WIDTH;
 use super::retired;
 use super::slice::SliceConfig;
 use crate::error::ModelError;
+use deepbrdf_data::mapping::MedianReference;
 
 /// PyTorch's default negative slope of the leaky ReLU (the paper does not give one).
 pub const NEGATIVE_SLOPE: f64 = 0.01;
@@ -71,6 +72,16 @@ impl AutoencoderConfig {
     /// decoder's shared by the slices; small enough to ship.
     pub fn slice(k: usize) -> Self {
         Self::new(k, Architecture::Slice(SliceConfig::preset(k)))
+    }
+
+    /// The eq. (1) reference this network is trained with, from the training set's median:
+    /// the median as it is, or with its peak flattened where the `slice` configuration asks
+    /// ([`SliceConfig::reference_flat_below_deg`]).
+    pub fn mapping_reference(&self, median: &MedianReference) -> MedianReference {
+        match self.slice_config().and_then(|s| s.reference_flat_below_deg) {
+            Some(deg) => median.flattened_below(deg),
+            None => median.clone(),
+        }
     }
 
     /// The slice network's settings, if it is one.

@@ -36,9 +36,14 @@ pub struct Args {
     /// --fold F` lists them).
     #[arg(long, value_name = "F")]
     pub fold: Option<usize>,
-    /// Error measures (comma-separated): mapped_mse (eq. 1 space), cos_rmse, image_relae
-    /// (renders the original and each reconstruction: ~0.3 s of CPU per pair).
-    #[arg(long, value_delimiter = ',', default_value = "mapped_mse,cos_rmse")]
+    /// Measures (comma-separated): mapped_mse (eq. 1 space), cos_rmse, image_relae (renders
+    /// the original and each reconstruction: ~0.3 s of CPU per pair), and the highlight's
+    /// defects, counted: dark_hole (a dark dot at its centre), tinted_centre (its colour moved).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "mapped_mse,cos_rmse,dark_hole,tinted_centre"
+    )]
     pub measures: Vec<Measure>,
     /// Methods (comma-separated): pca, ipca, ggx (the 7-number Lambertian + GGX attribute fit,
     /// `deepbrdf_eval::attributes`; needs --k 7), deepbrdf (trained with --preset into

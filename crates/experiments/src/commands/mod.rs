@@ -23,6 +23,7 @@ pub mod figures_loss;
 pub mod figures_quality;
 pub mod figures_recovery;
 pub mod folds;
+pub mod highlights;
 pub mod info;
 pub mod interpolate;
 pub mod pack_nbrdf;
@@ -56,6 +57,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Encode(args) => encode::run(args, &progress),
         Command::Decode(args) => decode::run(args, &progress),
         Command::Reconstruct(args) => reconstruct::run(args, &progress),
+        Command::Highlights(args) => highlights::run(args, &progress),
         Command::SweepK(args) => sweep_k::run(args, cli.quiet, &progress),
         Command::Render(args) => render::run(args, &progress),
         Command::Compare(args) => compare::run(args, &progress),

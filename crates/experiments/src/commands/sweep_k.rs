@@ -78,10 +78,15 @@ pub struct Args {
     /// results: `--out results/sweep-k-kfold5` refreshes them].
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// Error measures (comma-separated): mapped_mse (eq. 1 space, the paper's training loss),
+    /// Measures (comma-separated): mapped_mse (eq. 1 space, the paper's training loss),
     /// cos_rmse, image_relae (renders of the preview sphere under sun and sky, Fig. 7 in image
-    /// space; ~0.3 s of CPU per reconstruction).
-    #[arg(long, value_delimiter = ',', default_value = "mapped_mse,cos_rmse,image_relae")]
+    /// space; ~0.3 s of CPU per reconstruction), and the highlight's defects, counted:
+    /// dark_hole (a dark dot at the highlight's centre), tinted_centre (its colour moved).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "mapped_mse,cos_rmse,image_relae,dark_hole,tinted_centre"
+    )]
     pub measures: Vec<Measure>,
     /// Seed of the training runs and of the k-fold split.
     #[arg(long, default_value_t = 0)]

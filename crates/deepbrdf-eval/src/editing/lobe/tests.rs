@@ -159,3 +159,40 @@ fn judge_edit_and_tally_a_hand_made_pair() {
     let empty = MerlTable::from_values(vec![INVALID_VALUE; VALUES]);
     assert!(empty.map(|t| judge_edit(&lobe, &t, &rough(2.0)).is_err()).unwrap_or(false));
 }
+
+#[test]
+fn a_recoloured_centre_is_tinted_and_a_grey_one_is_not() {
+    // A grey (f0 grey) highlight on an orange floor; the same highlight tinted green.
+    let original = material(0.05, 0.04, ALBEDO, 1.0, 0.0);
+    let colour = original.centre_colour.unwrap_or([0.0; 3]);
+    // The centre is mostly the white highlight: close to grey, pulled a little toward orange.
+    assert!(colour[0] > colour[1] && colour[1] > colour[2] && colour[0] < 0.5, "{colour:?}");
+    assert_eq!(centre_shift(&original, &original), 0.0);
+    assert!(!tinted_centre(&original, &original));
+    // Brighter or darker by the same factor in every channel: not tinted.
+    let brighter = material(0.05, 0.04, ALBEDO, 1.5, 0.0);
+    assert!(centre_shift(&original, &brighter) < 0.02 && !tinted_centre(&original, &brighter));
+    // The lobe's green halved and its blue removed (a table of the same floor): tinted.
+    let spec = Ggx { alpha: 0.05, f0: [0.04, 0.02, 0.0], diffuse: [0.0; 3] };
+    let tinted = lobe_of(&tabulate(|wi, wo| {
+        let s = ggx(&spec, wi, wo);
+        std::array::from_fn(|c| ALBEDO[c] / PI + s[c])
+    }));
+    let shift = centre_shift(&original, &tinted);
+    assert!(shift > TINT_SHIFT && tinted_centre(&original, &tinted), "shift {shift}");
+    // A centre that went black where the original's was lit is tinted too.
+    let mut black = table(0.05, 0.04, ALBEDO, 1.0, 0.0);
+    for h in 0..CENTRE_BINS {
+        for d in 0..N_THETA_D {
+            for p in 0..N_PHI_D {
+                let cell = cell_index(h, d, p);
+                for c in 0..3 {
+                    let v = &mut black.values_mut()[c * CELLS + cell];
+                    *v = v.min(0.0);
+                }
+            }
+        }
+    }
+    let black = lobe_of(&black);
+    assert!(black.centre_colour.is_none() && tinted_centre(&original, &black));
+}

@@ -24,6 +24,18 @@ pub struct SliceConfig {
     /// H, the Fourier harmonics of phi_d the decoder MLP sees.
     #[config(default = 4)]
     pub harmonics: usize,
+    /// How much more the slice basis, and so the training loss and the refinement, weigh the
+    /// cells at the highlight's centre: cell weight `1 + e / (1 + theta_h index)`
+    /// ([`super::basis::pixel_weights`]); none (as in configurations written without the
+    /// field) or 0: unweighted.
+    #[config(default = "None")]
+    pub centre_emphasis: Option<f64>,
+    /// Flatten the eq. (1) reference's peak below this theta_h (degrees) before training
+    /// ([`deepbrdf_data::mapping::MedianReference::flattened_below`]); the model keeps the
+    /// reference it was trained with. None (as in configurations written without the field):
+    /// the median as it is.
+    #[config(default = "None")]
+    pub reference_flat_below_deg: Option<f64>,
     /// Extra training BRDFs (channel permutations, mixtures), used by the fits of the mean
     /// and components and by training.
     #[config(default = "AugmentationConfig::new()")]
@@ -56,6 +68,16 @@ impl SliceConfig {
             return Err(ModelError::Invalid(format!(
                 "{} principal components for k = {latent} (need k to {MAX_WIDTH})",
                 self.components
+            )));
+        }
+        if let Some(e) = self.centre_emphasis.filter(|e| !(0.0..=1e6).contains(e)) {
+            return Err(ModelError::Invalid(format!(
+                "a centre emphasis of {e} is out of range (0 to 1e6)"
+            )));
+        }
+        if let Some(a) = self.reference_flat_below_deg.filter(|a| !(0.0..=90.0).contains(a)) {
+            return Err(ModelError::Invalid(format!(
+                "a reference flattened below theta_h {a} deg is out of range (0 to 90)"
             )));
         }
         if self.hidden.is_some_and(|h| h == 0 || h > MAX_WIDTH) || self.harmonics > 64 {

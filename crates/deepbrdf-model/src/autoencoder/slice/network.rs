@@ -9,6 +9,9 @@
 //!   (phi_d enters as the Fourier features `cos(h phi_d), sin(h phi_d)`, h = 1..H), and the
 //!   image is `B^T` of them.
 //!
+//! With cell weights w emphasising the highlight's centre ([`super::basis`]), `B x` is `(w x)
+//! S^T` and the image `S^T a`; the coefficients' error is the weighted cells' error.
+//!
 //! Both MLPs' last layers start at zero: an untrained network is PCA in the mapped space within
 //! the slice basis' span. B (M x 8100), m and P (K x 540 M) are fixed, fitted before training
 //! (docs/model.md gives the preset's size). There is no per-value offset: B spans the mean
@@ -21,6 +24,7 @@ use burn::tensor::TensorData;
 
 use deepbrdf_data::layout::{PLANE, SIDE as INPUT_SIDE, SLICE_CHANNELS as INPUT_CHANNELS};
 
+use super::basis::pixel_weights;
 use super::config::SliceConfig;
 use super::mlp::{mlp_forward, mlp_layers};
 use crate::autoencoder::init::initializers;
@@ -48,6 +52,9 @@ pub struct SliceNetwork {
     latent: usize,
     harmonics: usize,
     negative_slope: f64,
+    /// The cell weights' emphasis of the highlight's centre ([`super::basis::pixel_weights`]);
+    /// 0: an orthonormal basis.
+    centre_emphasis: f64,
 }
 
 fn fixed<const D: usize>(shape: [usize; D], device: &Device) -> Param<Tensor<D>> {
@@ -79,6 +86,7 @@ impl SliceNetwork {
             latent: k,
             harmonics: layers.harmonics,
             negative_slope,
+            centre_emphasis: layers.centre_emphasis.unwrap_or(0.0),
         }
     }
 
@@ -137,13 +145,23 @@ impl SliceNetwork {
         mlp_forward(layers, x, self.negative_slope)
     }
 
-    /// `B x` for every image.
+    /// The cell weights of the basis ([`super::basis::pixel_weights`]).
+    pub fn pixel_weights(&self) -> Vec<f32> {
+        pixel_weights(self.centre_emphasis)
+    }
+
+    /// `(w x) S^T` for every image (the basis rows S are the synthesis directions, the cell
+    /// weights w those of [`super::basis`]).
     ///
     /// # Shapes
     /// - masked: `[batch, 540, 90, 90]` -> `[batch, 540 * M]`
     pub fn coefficients(&self, masked: Tensor<4>) -> Tensor<2> {
         let batch = masked.dims()[0];
-        let images = masked.reshape([batch * INPUT_CHANNELS, PLANE]); // [batch*540, 8100]
+        let mut images = masked.reshape([batch * INPUT_CHANNELS, PLANE]); // [batch*540, 8100]
+        if self.centre_emphasis != 0.0 {
+            let w = TensorData::new(self.pixel_weights(), [1, PLANE]);
+            images = images * Tensor::<2>::from_data(w, &self.basis.device());
+        }
         let a = images.matmul(self.basis.val().transpose()); // [batch*540, M]
         a.reshape([batch, self.coefficient_len()])
     }
@@ -185,7 +203,7 @@ impl SliceNetwork {
         self.head(self.principal_coordinates(coefficients))
     }
 
-    /// The slice basis' values, `M x 8100` row-major.
+    /// The slice basis' values (the synthesis directions S), `M x 8100` row-major.
     pub fn basis_values(&self) -> crate::error::Result<Vec<f32>> {
         crate::read_back::values(self.basis.val(), "the slice basis")
     }
@@ -204,6 +222,16 @@ impl SliceNetwork {
         Tensor::from_data(TensorData::new(values, [N_PHI_D, 2 * h]), device)
     }
 
+    /// The linear path of the decoder alone, `m + P[..k]^T z` (PCA within the basis' span).
+    ///
+    /// # Shapes
+    /// - latent: `[batch, k]` -> `[batch, 540 * M]`
+    pub fn decode_linear(&self, latent: Tensor<2>) -> Tensor<2> {
+        let [_, k] = latent.dims();
+        let head = self.components.val().slice([0..k, 0..self.coefficient_len()]); // [k, 540 M]
+        latent.matmul(head) + self.mean.val().unsqueeze_dim::<2>(0)
+    }
+
     /// The coefficients of the output: `m + P[..k]^T z + g(z, phi_d)` for each slice.
     ///
     /// # Shapes
@@ -211,8 +239,7 @@ impl SliceNetwork {
     pub fn decode_coefficients(&self, latent: Tensor<2>) -> Tensor<2> {
         let [batch, k] = latent.dims();
         let len = self.coefficient_len();
-        let head = self.components.val().slice([0..k, 0..len]); // [k, 540 M]
-        let linear = latent.clone().matmul(head) + self.mean.val().unsqueeze_dim::<2>(0);
+        let linear = self.decode_linear(latent.clone());
         if self.decoder.is_empty() {
             return linear;
         }
@@ -228,7 +255,7 @@ impl SliceNetwork {
         }
     }
 
-    /// `B^T a` for every image.
+    /// `S^T a` for every image.
     ///
     /// # Shapes
     /// - coefficients: `[batch, 540 * M]` -> `[batch, 540, 90, 90]`

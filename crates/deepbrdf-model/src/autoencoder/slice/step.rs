@@ -4,7 +4,9 @@
 //!
 //! For an orthonormal slice basis B, the squared error of an output `B^T a_hat` against a
 //! training layout x is `|a_hat - B x|^2` plus the (fixed) squared distance of x to B's span:
-//! training runs on the 540 x M coefficients of each BRDF, computed once. (The output is compared on every cell of each image; the masked
+//! training runs on the 540 x M coefficients of each BRDF, computed once. With cell weights
+//! ([`super::basis::pixel_weights`]) the same holds for the weighted error: eq. (4) with each
+//! cell counted by its weight, more at the highlight's centre. (The output is compared on every cell of each image; the masked
 //! loss of eq. (4) skips the cells invalid in that slice, where the target's projection is
 //! near 0: the coefficient loss bounds it from above.)
 
@@ -17,7 +19,7 @@ use deepbrdf_data::Progress;
 use deepbrdf_data::layout::LAYOUT_VALUES;
 
 use super::augmentation::sample_layout;
-use super::basis::{basis_t, fit_slice_basis, fit_weighted_components, project};
+use super::basis::{basis_t, fit_slice_basis, fit_weighted_components, pixel_weights, project};
 use super::config::SliceConfig;
 use crate::autoencoder::Autoencoder;
 use crate::error::ModelError;
@@ -162,9 +164,10 @@ fn prepare(
     progress.status(&format!("fitting a slice basis of {} directions", layers.directions));
     let layouts: Vec<&[f32]> = (0..data.len()).map(|i| data.input(i)).collect();
     let device = model.devices().into_iter().next().unwrap_or_default().without_autodiff();
-    let basis = fit_slice_basis(&layouts, layers.directions, seed, &device)?;
+    let cell_weights = pixel_weights(layers.centre_emphasis.unwrap_or(0.0));
+    let basis = fit_slice_basis(&layouts, layers.directions, &cell_weights, seed, &device)?;
     drop(layouts);
-    let bt = basis_t(&basis, &device);
+    let bt = basis_t(&basis, &cell_weights, &device);
     let augmentation = &layers.augmentation;
     let n = data.len();
     let samples = augmentation.samples(n);
@@ -192,7 +195,7 @@ fn prepare(
         if let Some(r) = reference {
             weights.extend(layouts.iter().map(|l| colour_weights(l, r, power)));
         }
-        for ((a, r), (_, count)) in project(&layouts, &bt)?.into_iter().zip(&made) {
+        for ((a, r), (_, count)) in project(&layouts, &bt, &cell_weights)?.into_iter().zip(&made) {
             targets.push(a);
             residuals.push(r);
             valid.push(*count);
@@ -215,7 +218,9 @@ fn prepare(
             if let Some(p) = power {
                 weights.extend(layouts.iter().map(|l| colour_weights(l, reference, p)));
             }
-            for ((a, r), (_, count)) in project(&layouts, &bt)?.into_iter().zip(group.iter()) {
+            for ((a, r), (_, count)) in
+                project(&layouts, &bt, &cell_weights)?.into_iter().zip(group.iter())
+            {
                 targets.push(a);
                 residuals.push(r);
                 valid.push(*count);
@@ -267,7 +272,7 @@ fn prepare(
                         .map(|(s, selection)| {
                             let input = filled_input(data, i, s, selection, seed);
                             centre(&mut row, &input, data.mask(i), None);
-                            Ok(project(&[&row], &bt)?.remove(0).0)
+                            Ok(project(&[&row], &bt, &cell_weights)?.remove(0).0)
                         })
                         .collect::<crate::error::Result<Vec<_>>>()
                 })
