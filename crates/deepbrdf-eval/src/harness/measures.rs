@@ -96,8 +96,9 @@ pub struct Original<'a> {
     cells: Vec<u32>,
     /// Eq. (1) of the original at `cells`, channel-major (`c * cells.len() + m`).
     mapped: Vec<f32>,
-    /// The original's specular lobe; `None` where it cannot be read ([`Lobe::of`]).
-    lobe: Option<Lobe>,
+    /// The original's specular lobe, read when a highlight measure first asks; `None` where it
+    /// cannot be read ([`Lobe::of`]).
+    lobe: std::sync::OnceLock<Option<Lobe>>,
 }
 
 /// Valid cells per parallel work item.
@@ -137,7 +138,7 @@ impl Yardstick {
                 }
             });
         }
-        Original { table, cells, mapped, lobe: Lobe::of(table).ok() }
+        Original { table, cells, mapped, lobe: std::sync::OnceLock::new() }
     }
 
     /// All `measures` of `recon` against `original`, in the given order. A reconstruction that
@@ -193,7 +194,11 @@ impl Yardstick {
         let (mapped_sum, cos_sum) = parts.iter().fold((0.0, 0.0), |x, y| (x.0 + y.0, x.1 + y.1));
         let count = (3 * n) as f64;
         let defects = match measures.iter().any(|m| m.counts()) {
-            true => original.lobe.as_ref().map(|o| highlight_defects(o, recon)),
+            true => original
+                .lobe
+                .get_or_init(|| Lobe::of(original.table).ok())
+                .as_ref()
+                .map(|o| highlight_defects(o, recon)),
             false => None,
         };
         let flag = |d: Option<(bool, bool)>, pick: fn((bool, bool)) -> bool| {
