@@ -229,3 +229,31 @@ fn folds_lists_the_materials_each_fold_of_baselines_scores() {
     let out = util::run_in(dir.path(), &["baselines", "--k", "1", "--data", d, "--fold", "0"]);
     util::assert_clean_failure(&out, "kfold mode only");
 }
+
+/// Sun et al. 2018's separation runs beside the others: its row in the table, its error
+/// falling with k, and a k with no specular coefficient refused with the reason.
+#[test]
+fn baselines_runs_sun2018_beside_ipca() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("data");
+    write_materials(&data, 5);
+    let data = data.to_str().unwrap();
+    let args = ["baselines", "--data", data, "--k", "2,4", "--methods", "ipca,sun2018"];
+    let out = util::run_in(dir.path(), &[&args[..], &["--out", "res"]].concat());
+    assert!(out.status.success(), "{}", util::stderr(&out));
+    let text = util::stdout(&out);
+    let row = text.lines().find(|l| l.starts_with("| Sun2018 |")).unwrap_or_default();
+    let errors: Vec<f64> =
+        row.trim_matches('|').split('|').skip(1).filter_map(|f| f.trim().parse().ok()).collect();
+    assert!(errors.len() >= 2 && errors[1] < errors[0], "{text}");
+    let rows = read_results(&dir.path().join("res/results.csv"));
+    assert!(rows.keys().any(|(m, k, _, _)| m == "Sun2018" && *k == 4), "no Sun2018 rows");
+
+    let out = util::run_in(
+        dir.path(),
+        &["baselines", "--data", data, "--k", "1", "--methods", "sun2018", "--out", "res2"],
+    );
+    assert!(!out.status.success());
+    let err = util::stderr(&out);
+    assert!(err.contains("k = 1") && err.contains("no specular"), "{err}");
+}

@@ -54,6 +54,21 @@ impl MedianReference {
     /// cell that is valid in no table gets the reference 0 (it is never mapped: invalid cells map
     /// to 0 whatever the reference).
     pub fn from_tables(tables: &[&MerlTable]) -> Result<Self> {
+        Self::from_remainders(tables, &vec![[0.0; 3]; tables.len()])
+    }
+
+    /// The per-value median of what is left of each table once a constant per channel is
+    /// taken off, `tables[t] - less[t]`, floored at 0 (a reference is non-negative): the
+    /// reference of the specular parts of a diffuse-specular separation, `less` the diffuse
+    /// BRDFs `albedo / pi` (Sun et al. 2018). Otherwise as [`MedianReference::from_tables`].
+    pub fn from_remainders(tables: &[&MerlTable], less: &[[f32; 3]]) -> Result<Self> {
+        if less.len() != tables.len() {
+            return Err(DataError::Invalid(format!(
+                "{} tables but {} constants to take off them",
+                tables.len(),
+                less.len()
+            )));
+        }
         if tables.is_empty() {
             return Err(DataError::Invalid("the median reference needs at least one table".into()));
         }
@@ -66,17 +81,17 @@ impl MedianReference {
                     for b in bufs.iter_mut() {
                         b.clear();
                     }
-                    for t in tables {
+                    for (t, off) in tables.iter().zip(less) {
                         if t.is_valid(cell) {
                             let v = t.values();
                             for (c, b) in bufs.iter_mut().enumerate() {
-                                b.push(v[c * CELLS + cell]);
+                                b.push(v[c * CELLS + cell] - off[c]);
                             }
                         }
                     }
                     let mut out = [0f32; 3];
                     for (o, b) in out.iter_mut().zip(bufs.iter_mut()) {
-                        *o = median(b);
+                        *o = median(b).max(0.0);
                     }
                     out
                 },
@@ -200,7 +215,7 @@ impl MedianReference {
 
 /// Median of `values` (reordered in place); the mean of the two middle values for an even count;
 /// 0 for none.
-fn median(values: &mut [f32]) -> f32 {
+pub fn median(values: &mut [f32]) -> f32 {
     let n = values.len();
     if n == 0 {
         return 0.0;
@@ -279,6 +294,19 @@ mod tests {
         assert!(!cell_is_valid(60, 89, 0));
         assert_eq!(v[invalid], 0.0);
         assert!(MedianReference::from_tables(&[]).is_err());
+
+        // Less a constant per table and channel: the median of the remainders, floored at 0.
+        let less = [[0.5, 0.0, 100.0], [1.0, 0.0, 100.0], [1.5, 0.0, 100.0], [0.0, 0.0, 100.0]];
+        let remainders = MedianReference::from_remainders(&refs, &less)?;
+        let pattern = |c: usize| 1.0 + c as f32 + (cell % 7) as f32;
+        let p = pattern(0);
+        let mut sorted = [1.0 * p - 0.5, 2.0 * p - 1.0, 3.0 * p - 1.5, 10.0 * p];
+        sorted.sort_by(f32::total_cmp);
+        let expected = (0.5 * (f64::from(sorted[1]) + f64::from(sorted[2]))) as f32;
+        assert_eq!(remainders.values()[cell], expected);
+        assert_eq!(remainders.values()[CELLS + cell], v[CELLS + cell]);
+        assert_eq!(remainders.values()[2 * CELLS + cell], 0.0, "floored at 0");
+        assert!(MedianReference::from_remainders(&refs, &less[..2]).is_err());
         Ok(())
     }
 

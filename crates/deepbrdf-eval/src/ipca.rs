@@ -15,9 +15,11 @@
 pub const EPSILON: f64 = 1e-3;
 
 /// The forward mapping `ln((rho w + eps) / (rho_ref w + eps))`, `w = cos(theta_i) cos(theta_o)`.
+/// A negative `rho` (a specular remainder where a diffuse part taken off exceeds the table,
+/// [`crate::separation`]) is floored at `rho w = -eps / 2`, so the logarithm stays finite.
 #[inline]
 pub fn cosine_log_relative(rho: f64, rho_ref: f64, w: f64) -> f64 {
-    ((rho * w + EPSILON) / (rho_ref * w + EPSILON)).ln()
+    ((rho * w + EPSILON).max(0.5 * EPSILON) / (rho_ref * w + EPSILON)).ln()
 }
 
 /// Inverse of [`cosine_log_relative`]: `rho = ((rho_ref w + eps) exp(y) - eps) / w`.

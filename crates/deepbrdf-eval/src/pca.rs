@@ -26,10 +26,11 @@ const BLOCK: usize = 4096;
 /// take the same 0.001 as the paper's eq. (1).
 pub const LOG_EPSILON: f64 = 1e-3;
 
-/// Traditional PCA's forward mapping of a reflectance: `ln(rho + LOG_EPSILON)`.
+/// Traditional PCA's forward mapping of a reflectance: `ln(rho + LOG_EPSILON)` (a negative
+/// `rho`, a remainder, floored at `-LOG_EPSILON / 2` so the logarithm stays finite).
 #[inline]
 pub fn log_map(rho: f64) -> f64 {
-    (rho + LOG_EPSILON).ln()
+    (rho + LOG_EPSILON).max(0.5 * LOG_EPSILON).ln()
 }
 
 /// Inverse of [`log_map`]: `exp(y) - LOG_EPSILON` (may be negative for a truncated basis).

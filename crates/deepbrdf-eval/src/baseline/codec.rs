@@ -39,7 +39,7 @@ impl BaselineCodec {
     /// One codec per entry of `ks`, in that order, sharing one encoding of each BRDF at the
     /// largest of `ks` (the last BRDF encoded is remembered, keyed by its content).
     pub fn nested(basis: &Arc<BaselineBasis>, ks: &[usize]) -> Result<Vec<Self>> {
-        let shared = Arc::new(SharedEncoding { k_max: max_k(ks)?, last: Mutex::new(None) });
+        let shared = Arc::new(SharedEncoding::new(max_k(ks)?));
         ks.iter()
             .map(|&k| Ok(Self { shared: Some(Arc::clone(&shared)), ..Self::new(basis, k)? }))
             .collect()
@@ -62,7 +62,10 @@ impl Codec for BaselineCodec {
 
     fn encode(&self, table: &MerlTable) -> Result<Vec<f32>> {
         match &self.shared {
-            Some(shared) => Ok(shared.coefficients(&self.basis, table)?[..self.k].to_vec()),
+            Some(shared) => {
+                let code = shared.coefficients(table, |t, k| self.basis.encode(t, k))?;
+                Ok(code[..self.k].to_vec())
+            }
             None => self.basis.encode(table, self.k),
         }
     }
@@ -81,21 +84,31 @@ impl Codec for BaselineCodec {
 }
 
 /// The largest of `ks` (an error when there is none).
-pub(super) fn max_k(ks: &[usize]) -> Result<usize> {
+pub(crate) fn max_k(ks: &[usize]) -> Result<usize> {
     ks.iter().copied().max().ok_or_else(|| EvalError::Invalid("no k given".into()))
 }
 
-/// The coefficients (at the largest k of a nested set of codecs) of the last BRDF encoded.
-struct SharedEncoding {
+/// The coefficients (at the largest k of a nested set of codecs) of the last BRDF encoded:
+/// shared by codecs whose coefficients at k are the first k of those at the largest k.
+pub(crate) struct SharedEncoding {
     k_max: usize,
     last: Mutex<Option<(MerlTable, Arc<Vec<f32>>)>>,
 }
 
 impl SharedEncoding {
-    /// The coefficients of `table` at the largest k, computed once per table (keyed by the
-    /// table's content, so another table, or the same values elsewhere in memory, is never
-    /// confused with it).
-    fn coefficients(&self, basis: &BaselineBasis, table: &MerlTable) -> Result<Arc<Vec<f32>>> {
+    /// An empty cache for codecs up to `k_max`.
+    pub(crate) fn new(k_max: usize) -> Self {
+        Self { k_max, last: Mutex::new(None) }
+    }
+
+    /// The coefficients of `table` at the largest k (`encode(table, k_max)`), computed once per
+    /// table (keyed by the table's content, so another table, or the same values elsewhere in
+    /// memory, is never confused with it).
+    pub(crate) fn coefficients(
+        &self,
+        table: &MerlTable,
+        encode: impl FnOnce(&MerlTable, usize) -> Result<Vec<f32>>,
+    ) -> Result<Arc<Vec<f32>>> {
         if let Ok(last) = self.last.lock() {
             if let Some((cached, code)) = last.as_ref() {
                 if cached == table {
@@ -103,7 +116,7 @@ impl SharedEncoding {
                 }
             }
         }
-        let code = Arc::new(basis.encode(table, self.k_max)?);
+        let code = Arc::new(encode(table, self.k_max)?);
         if let Ok(mut last) = self.last.lock() {
             *last = Some((table.clone(), code.clone()));
         }

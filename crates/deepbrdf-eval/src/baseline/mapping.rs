@@ -88,6 +88,13 @@ impl Mapping {
     /// Maps `table` to a row over `domain`. A domain cell that is invalid in `table` gets NaN
     /// (the codec replaces it with the basis mean).
     pub fn forward(&self, domain: &Domain, table: &MerlTable) -> Vec<f32> {
+        self.forward_less(domain, table, [0.0; 3])
+    }
+
+    /// [`Mapping::forward`] of what is left of `table` once `less[c]` is taken off every value of
+    /// channel c: the specular part of a BRDF whose diffuse part is `less`
+    /// ([`crate::separation`]). A remainder below zero is floored as the mappings say.
+    pub fn forward_less(&self, domain: &Domain, table: &MerlTable, less: [f64; 3]) -> Vec<f32> {
         let n = domain.cells().len();
         let values = table.values();
         let mut row = vec![0f32; domain.dim()];
@@ -101,7 +108,7 @@ impl Mapping {
                         *o = f32::NAN;
                         continue;
                     }
-                    let rho = f64::from(values[c * CELLS + cell]);
+                    let rho = f64::from(values[c * CELLS + cell]) - less[c];
                     *o = match self {
                         Self::Log => pca::log_map(rho),
                         Self::LogRelative { reference, cos_weight } => ipca::cosine_log_relative(
@@ -119,6 +126,12 @@ impl Mapping {
     /// Inverse of [`Mapping::forward`]: a full table, valid exactly on `domain`, reflectance
     /// clamped to `[0, f32::MAX]` (a truncated basis can decode below zero).
     pub fn inverse(&self, domain: &Domain, row: &[f32]) -> Result<MerlTable> {
+        self.inverse_plus(domain, row, [0.0; 3])
+    }
+
+    /// [`Mapping::inverse`] with `plus[c]` added to every value of channel c before the clamp:
+    /// a decoded specular part plus its diffuse part ([`crate::separation`]).
+    pub fn inverse_plus(&self, domain: &Domain, row: &[f32], plus: [f64; 3]) -> Result<MerlTable> {
         if row.len() != domain.dim() {
             return Err(EvalError::Invalid(format!(
                 "row of length {} for a domain of {} values",
@@ -145,7 +158,7 @@ impl Mapping {
                         )
                     }
                 };
-                out[cell as usize - first] = clamp_reflectance(rho);
+                out[cell as usize - first] = clamp_reflectance(rho + plus[c]);
             }
         });
         Ok(MerlTable::from_values(values)?)

@@ -7,13 +7,13 @@ mod domain;
 mod mapping;
 
 pub use codec::BaselineCodec;
+pub(crate) use codec::{max_k, SharedEncoding};
 pub use domain::Domain;
 pub use mapping::{Mapping, MappingKind};
 
 use crate::error::{EvalError, Result};
 use crate::harness::{Codec, FoldTraining, Method};
 use crate::pca::LinearBasis;
-use codec::max_k;
 use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::{MerlTable, Progress};
 use std::path::Path;
@@ -68,7 +68,45 @@ impl BaselineBasis {
                 }
             },
         };
-        let rows: Vec<Vec<f32>> = train.iter().map(|t| mapping.forward(&domain, t)).collect();
+        Self::fit_mapped(name, domain, mapping, train, &vec![[0.0; 3]; train.len()], k, progress)
+    }
+
+    /// IPCA's mapping and `k` components fitted to what is left of each training table once
+    /// `less[t][c]` is taken off every value of channel c: the specular parts of a
+    /// diffuse-specular separation ([`crate::separation`]). `reference` must be their median
+    /// ([`MedianReference::from_remainders`]).
+    pub fn fit_remainders(
+        name: &str,
+        train: &[&MerlTable],
+        less: &[[f64; 3]],
+        reference: &MedianReference,
+        k: usize,
+        progress: &dyn Progress,
+    ) -> Result<Self> {
+        if train.len() < 2 || less.len() != train.len() {
+            return Err(EvalError::Invalid(format!(
+                "{name} needs at least 2 training tables, each with its part to take off (got {} \
+                 tables, {} parts)",
+                train.len(),
+                less.len()
+            )));
+        }
+        let domain = Domain::common(train)?;
+        let mapping = Mapping::log_relative(&domain, reference.values())?;
+        Self::fit_mapped(name, domain, mapping, train, less, k, progress)
+    }
+
+    fn fit_mapped(
+        name: &str,
+        domain: Domain,
+        mapping: Mapping,
+        train: &[&MerlTable],
+        less: &[[f64; 3]],
+        k: usize,
+        progress: &dyn Progress,
+    ) -> Result<Self> {
+        let rows: Vec<Vec<f32>> =
+            train.iter().zip(less).map(|(t, &l)| mapping.forward_less(&domain, t, l)).collect();
         let refs: Vec<&[f32]> = rows.iter().map(|r| r.as_slice()).collect();
         let basis = LinearBasis::fit(&refs, k, progress)?;
         Ok(Self { name: name.to_string(), domain, mapping, basis, n_train: train.len() })
@@ -101,7 +139,13 @@ impl BaselineBasis {
 
     /// `k` coefficients of `table`. Domain cells invalid in `table` are taken at the mean.
     pub fn encode(&self, table: &MerlTable, k: usize) -> Result<Vec<f32>> {
-        let mut row = self.mapping.forward(&self.domain, table);
+        self.encode_less(table, [0.0; 3], k)
+    }
+
+    /// [`BaselineBasis::encode`] of what is left of `table` once `less[c]` is taken off each
+    /// value of channel c (a basis fitted by [`BaselineBasis::fit_remainders`]).
+    pub fn encode_less(&self, table: &MerlTable, less: [f64; 3], k: usize) -> Result<Vec<f32>> {
+        let mut row = self.mapping.forward_less(&self.domain, table, less);
         for (x, &m) in row.iter_mut().zip(self.basis.mean()) {
             if x.is_nan() {
                 *x = m;
@@ -112,11 +156,17 @@ impl BaselineBasis {
 
     /// The table of coefficients `code` (`code.len()` components used).
     pub fn decode(&self, code: &[f32]) -> Result<MerlTable> {
+        self.decode_plus(code, [0.0; 3])
+    }
+
+    /// [`BaselineBasis::decode`] with `plus[c]` added to every value of channel c (the
+    /// diffuse part of a separated BRDF).
+    pub fn decode_plus(&self, code: &[f32], plus: [f64; 3]) -> Result<MerlTable> {
         if let Some(i) = code.iter().position(|c| !c.is_finite()) {
             return Err(EvalError::Invalid(format!("coefficient {i} is {}", code[i])));
         }
         let row = self.basis.decode(code)?;
-        self.mapping.inverse(&self.domain, &row)
+        self.mapping.inverse_plus(&self.domain, &row, plus)
     }
 
     /// Writes the basis as an artifact file (atomic: temp file, then rename).

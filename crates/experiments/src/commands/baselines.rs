@@ -1,4 +1,5 @@
-//! `experiments baselines`: the PCA and IPCA baselines of §4 (Hu et al. 2020) through the
+//! `experiments baselines`: the PCA and IPCA baselines of §4 (Hu et al. 2020) and Sun et al.
+//! 2018's separation (Fig. 8) through the
 //! evaluation harness: fit, encode/decode every material at each k, measure, print the summary
 //! table and write the results folder (CSV, markdown, Fig. 3 / Fig. 7 style plots).
 use crate::args::data::DataArgs;
@@ -9,6 +10,7 @@ use deepbrdf_eval::attributes::AttributeMethod;
 use deepbrdf_eval::baseline::BaselineMethod;
 use deepbrdf_eval::deep::DeepMethod;
 use deepbrdf_eval::harness::{self, HarnessConfig, Materials, Measure, Method, Mode};
+use deepbrdf_eval::separation::SeparatedMethod;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -45,7 +47,9 @@ pub struct Args {
         default_value = "mapped_mse,cos_rmse,dark_hole,tinted_centre"
     )]
     pub measures: Vec<Measure>,
-    /// Methods (comma-separated): pca, ipca, ggx (the 7-number Lambertian + GGX attribute fit,
+    /// Methods (comma-separated): pca, ipca, sun2018 (Sun et al. 2018's diffuse-specular
+    /// separation, Fig. 8: 1 diffuse + k - 1 specular coefficients), ggx (the 7-number
+    /// Lambertian + GGX attribute fit,
     /// `deepbrdf_eval::attributes`; needs --k 7), deepbrdf (trained with --preset into
     /// --models, or loaded from there when finished).
     #[arg(long, value_name = "NAME,...", value_delimiter = ',', default_value = "pca,ipca")]
@@ -103,8 +107,8 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         bail!("--eval-collections is for generalize mode only");
     }
     for m in &args.methods {
-        if !["pca", "ipca", "ggx", "deepbrdf"].contains(&m.as_str()) {
-            bail!("unknown method '{m}' (pca, ipca, ggx, deepbrdf)");
+        if !["pca", "ipca", "sun2018", "ggx", "deepbrdf"].contains(&m.as_str()) {
+            bail!("unknown method '{m}' (pca, ipca, sun2018, ggx, deepbrdf)");
         }
     }
     if args.methods.iter().any(|m| m == "ggx") && args.ks != [7] {
@@ -161,6 +165,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     };
     let eval_label = eval.as_ref().map(|e| format!("{} ({} materials)", e.label, e.len()));
     let ggx = AttributeMethod::default();
+    let sun = SeparatedMethod::default();
     let preset = args.preset;
     let models = args.models.clone().unwrap_or_else(|| out.join("models"));
     let deep = DeepMethod::new(
@@ -179,6 +184,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             "pca" => &pca as &dyn Method,
             "ipca" => &ipca,
             "deepbrdf" => &deep,
+            "sun2018" => &sun,
             _ => &ggx,
         })
         .collect();
