@@ -33,9 +33,9 @@ pub struct SeparatedBasis {
 
 impl SeparatedBasis {
     /// Separates `train` and fits `specular` specular components (Sun et al. 2018, §4): from
-    /// albedos of 0, alternately fit the search basis to the specular parts and move each
-    /// albedo to where its specular part is best explained, until no albedo moves; then fit
-    /// the diffuse and specular PCAs.
+    /// each table's smallest value, fit the search basis to the specular parts and move each
+    /// albedo to where the BRDF is best explained (the configured number of rounds, or until no
+    /// albedo moves); then fit the diffuse and specular PCAs.
     pub fn fit(
         name: &str,
         config: &SeparationConfig,

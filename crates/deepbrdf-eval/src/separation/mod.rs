@@ -4,14 +4,15 @@
 //! 2018, §4.
 //!
 //! A BRDF is a Lambertian part `albedo / pi` per channel plus a specular part. Which albedo a
-//! measured BRDF has is not measured; the separation picks, per BRDF, the albedo whose
-//! specular part the collection's specular parts explain best: it alternates a PCA of the
-//! specular parts (in IPCA's mapped space, [`crate::ipca`]) with a search of each BRDF's albedo
-//! that leaves the smallest residual off the first few components ([`SeparationConfig`]), until
-//! the albedos settle. The representation then holds PCA coefficients of the albedo and of the
-//! specular part, separately: Fig. 8 gives the diffuse part 1 dimension and the specular part 9
-//! at k = 10, and [`SeparatedMethod`] runs at any k as 1 + (k - 1). The authors publish no code;
-//! the choices the paper leaves open are [`SeparationConfig`]'s, with their reasons.
+//! measured BRDF has is not measured; the separation picks, per BRDF, the albedo at which the
+//! collection's specular parts explain it best: from the classical estimate (the table's
+//! smallest value, [`lowest_albedos`]) it fits a PCA of the specular parts (in IPCA's mapped
+//! space, [`crate::ipca`]) and searches each BRDF's albedo against it ([`SearchBasis`]), as
+//! often as [`SeparationConfig::iterations`] says. The representation then holds PCA
+//! coefficients of the albedo and of the specular part, separately: Fig. 8 gives the diffuse
+//! part 1 dimension and the specular part 9 at k = 10, and [`SeparatedMethod`] runs at any k as
+//! 1 + (k - 1). The authors publish no code; the choices the paper leaves open are
+//! [`SeparationConfig`]'s, with their reasons.
 
 mod basis;
 mod search;
@@ -38,11 +39,13 @@ pub struct SeparationConfig {
     /// the albedo is kept as found, and a full set of specular components reproduces every
     /// training BRDF.
     pub diffuse_dims: usize,
-    /// Specular components the separation measures a residual against: 9, the specular
-    /// dimensions of Fig. 8 (fewer for a small collection: at most n - 2, since n - 1 explain
-    /// any training row whatever its albedo).
+    /// Specular components of the search's basis: 9, the specular dimensions of Fig. 8 (fewer
+    /// for a small collection: a basis explains any of its own rows with one less component
+    /// than it has rows, whatever the row's albedo).
     pub search_components: usize,
-    /// At most this many alternations of search and fit (it stops when no albedo moves).
+    /// Rounds of fit and search, at most (it stops when no albedo moves). One: the albedos
+    /// of a Lambertian + GGX collection move away from the truth with every further round, as
+    /// each round's basis learns the last round's errors (docs/results.md).
     pub iterations: usize,
     /// The search looks at every `stride`-th cell of the domain.
     pub stride: usize,
@@ -50,7 +53,7 @@ pub struct SeparationConfig {
 
 impl Default for SeparationConfig {
     fn default() -> Self {
-        Self { diffuse_dims: 1, search_components: 9, iterations: 6, stride: 32 }
+        Self { diffuse_dims: 1, search_components: 9, iterations: 1, stride: 32 }
     }
 }
 

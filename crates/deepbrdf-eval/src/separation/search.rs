@@ -21,7 +21,7 @@ const GRID: usize = 10;
 /// Golden-section steps after the grid (the bracket shrinks to 0.618^12 ~ 3e-3 of itself).
 const GOLDEN_STEPS: usize = 12;
 /// Sweeps of the three channels in turn (each channel's best albedo moves the others').
-const SWEEPS: usize = 2;
+const SWEEPS: usize = 3;
 
 /// `pi` times each channel's smallest value of `table` over `domain`: the largest albedo that
 /// leaves no specular value below zero (Sun et al. 2018's constraint), the separation's bound
@@ -148,11 +148,14 @@ impl SearchBasis {
     }
 
     /// The albedo per channel at which `values` is best explained as that Lambertian part
-    /// plus the basis' reconstruction of the rest ([`SearchBasis::error`]): each channel in
-    /// turn over `[0, bounds]` ([`lowest_albedos`]; a grid, then golden sections around its best point), from the
+    /// plus the basis' reconstruction of the rest ([`SearchBasis::error`]): the three bounds
+    /// scaled together, then each channel in turn over `[0, bounds]` ([`lowest_albedos`]; a grid, then golden sections around its best point), from the
     /// largest albedo that leaves no specular value below zero (the bound), [`SWEEPS`] times.
     pub fn separate(&self, sample: &Sample, values: &[f32], bounds: [f64; 3]) -> [f64; 3] {
-        let mut albedo = bounds;
+        // First all channels together, as a fraction of their bounds: one channel searched
+        // while the others sit at their bounds sees the wrong landscape.
+        let t = minimise(|t| self.error(sample, values, bounds.map(|b| t * b)), 1.0);
+        let mut albedo = bounds.map(|b| t * b);
         for _ in 0..SWEEPS {
             for c in 0..3 {
                 let cost = |a: f64| {

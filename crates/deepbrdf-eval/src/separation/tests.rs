@@ -1,3 +1,4 @@
+use super::search::lowest_albedos;
 use super::*;
 use crate::baseline::Domain;
 use deepbrdf_data::merl::{grid::cos_weights, CELLS};
@@ -38,11 +39,11 @@ fn median(mut values: Vec<f64>) -> f64 {
 
 /// The bar is 2% on every material. Measured, it is met on a smooth lobe over a
 /// coloured albedo (the held-out one, 0.1%) and not across the collection: the median training
-/// material is 9% off, where the table's smallest value (the classical estimate, the search's
-/// start) is 6% off; a broad bright lobe is itself nearly Lambertian and takes albedo from it
-/// (docs/results.md, "Sun et al. 2018"). This guards what holds.
+/// material is 4.6% off, where the table's smallest value (the classical estimate, the search's
+/// start) is 6.4% off; a broad bright lobe is itself nearly Lambertian and takes albedo from it
+/// (docs/results.md, "Sun et al. 2018"). This checks what holds: better than the start.
 #[test]
-fn on_lambertian_plus_ggx_materials_the_separation_finds_a_smooth_lobes_albedo() {
+fn on_lambertian_plus_ggx_materials_it_improves_on_the_smallest_value_estimate() {
     let lobes: Vec<Ggx> = (0..25).map(lambert_ggx).collect();
     let tables: Vec<MerlTable> = lobes.iter().map(lambert_ggx_table).collect();
     let refs: Vec<&MerlTable> = tables[..24].iter().collect();
@@ -64,7 +65,10 @@ fn on_lambertian_plus_ggx_materials_the_separation_finds_a_smooth_lobes_albedo()
     // One it was not fitted on: a smooth dielectric lobe over a coloured albedo.
     let held_out = basis.separate(&tables[24]);
     let err = albedo_error(&held_out, &lobes[24].diffuse);
-    assert!(found < 0.12 && start < 0.1, "median error {found} (the smallest value's {start})");
+    assert!(
+        found < 0.06 && found < 0.8 * start,
+        "median error {found} (the smallest value's {start})"
+    );
     assert!(err < 0.02, "held out: found {held_out:?}, truth {:?}", lobes[24].diffuse);
 }
 
