@@ -35,6 +35,33 @@ fn figures_generalize_writes_fig9_with_both_methods_relae() {
     }
     assert!(summary.contains("| n3 |") && summary.contains("**mean**"), "{summary}");
     assert!(out.join("fig9.jpg").is_file());
+
+    // Fig. 8: Sun et al. 2018's separation as the baseline (fitted on four materials, the
+    // fewest it takes), one material picked; a name not in the data is refused.
+    let four = dir.path().join("four");
+    std::fs::create_dir(&four).unwrap();
+    for i in 0..4 {
+        deepbrdf_data::merl::write_merl(&util::material(i), four.join(format!("m{i}.binary")))
+            .unwrap();
+    }
+    let out = dir.path().join("fig8");
+    let four = s(&four);
+    let sun = [&args[..], &["--baseline", "sun2018", "--ipca-data", &four]].concat();
+    let o = util::run_in(
+        dir.path(),
+        &[&sun[..], &["--materials", "n4", "--out", &s(&out), "--size", "64", "--spp", "4"]]
+            .concat(),
+    );
+    assert!(o.status.success(), "{}", util::stderr(&o));
+    let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    assert!(summary.starts_with("Fig. 8") && summary.contains("| Sun2018 |"), "{summary}");
+    let csv = std::fs::read_to_string(out.join("fig8.csv")).unwrap();
+    assert_eq!(csv.lines().next(), Some("material,render_noise,relae_deepbrdf,relae_sun2018"));
+    assert_eq!(csv.lines().count(), 2, "{csv}");
+    assert!(csv.lines().nth(1).unwrap().starts_with("n4,"), "{csv}");
+    assert!(out.join("fig8.jpg").is_file());
+    let refused = util::run_in(dir.path(), &[&sun[..], &["--materials", "nope"]].concat());
+    util::assert_clean_failure(&refused, "'nope' is not in");
 }
 
 /// `figures-loss` (Fig. 4): the same tiny network trained with `--loss l2` and `--loss l1`,

@@ -99,7 +99,8 @@ pub enum Command {
     /// (Fig. 10): renders and tables.
     Interpolate(commands::interpolate::Args),
     /// Fig. 9: materials no representation was fitted to (default: the real RGL measurements),
-    /// as measured, as DeepBRDF and as IPCA reconstruct them, with the image RelAE of each.
+    /// as measured, as DeepBRDF and as IPCA reconstruct them, with the image RelAE of each;
+    /// Fig. 8 with `--baseline sun2018` (Sun et al. 2018's separation instead of IPCA).
     FiguresGeneralize(commands::figures_generalize::Args),
     /// Fig. 4: the same network trained with the L2 and the L1 loss (`train --loss l1`), each
     /// material as measured and as each model reconstructs it, with the image RelAE of each.

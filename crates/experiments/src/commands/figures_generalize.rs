@@ -1,10 +1,16 @@
-//! `experiments figures-generalize [--model DIR] [--collection rgl-measured | --data DIR]`:
-//! Fig. 9 of Hu et al. (2020) on materials no representation was fitted to (by default the
-//! seven real RGL measurements): each material rendered as measured, as DeepBRDF reconstructs it
-//! (eq. 2 then eq. 3) and as IPCA does at the model's k, IPCA fitted on the model's training
+//! `experiments figures-generalize [--model DIR] [--collection rgl-measured | --data DIR]
+//! [--baseline ipca | sun2018] [--materials LIST]`: Figs. 9 and 8 of Hu et al. (2020), one
+//! kind of figure: each material rendered as measured, as DeepBRDF reconstructs it (eq. 2 then
+//! eq. 3) and as a baseline does at the model's k, the baseline fitted on the model's training
 //! data; the image RelAE of each reconstruction under its caption (the harness's measure,
-//! [`ImageRelae`]: the preview sphere, sun and sky), rendered at the figure settings
-//! (`--size`, `--spp`, `--seed`), with the renderer's noise measured beside it.
+//! [`ImageRelae`]: the preview sphere, sun and sky), rendered at the figure settings (`--size`,
+//! `--spp`, `--seed`), with the renderer's noise measured beside it.
+//!
+//! - Fig. 9 (the default): IPCA, on materials no representation was fitted to (the seven real
+//!   RGL measurements).
+//! - Fig. 8 (`--baseline sun2018`): Sun et al. 2018's separation (1 diffuse + k - 1 specular
+//!   coefficients), on `merl` materials with changing colour or complex lobes: in-sample, as
+//!   the paper's figure, when the model was trained on them (said so in the summary).
 use crate::args::data::{load_added, CacheArg};
 use crate::args::model::ModelArg;
 use crate::editing::ModelCodec;
@@ -14,8 +20,9 @@ use deepbrdf_data::dataset::{DataSource, Dataset};
 use deepbrdf_data::files::write_atomic;
 use deepbrdf_data::Progress;
 use deepbrdf_eval::baseline::{BaselineBasis, MappingKind};
-use deepbrdf_eval::harness::Codec;
+use deepbrdf_eval::harness::{Codec, Method as _};
 use deepbrdf_eval::metrics::{relae, ImageRelae};
+use deepbrdf_eval::separation::SeparatedMethod;
 use deepbrdf_eval::stats::finite_mean;
 use deepbrdf_model::DeepBrdf;
 use deepbrdf_render::sheet::{contact_sheet, SheetConfig, Tile};
@@ -34,20 +41,63 @@ pub struct Args {
     /// A folder of MERL .binary files to show instead.
     #[arg(long, value_name = "DIR")]
     pub data: Option<PathBuf>,
-    /// Fit IPCA on this folder of MERL .binary files [default: the bundled `merl` collection,
-    /// which must be what the model was trained on].
+    /// Show only these materials of the collection or folder (comma-separated names).
+    #[arg(long, value_name = "NAME,...", value_delimiter = ',')]
+    pub materials: Option<Vec<String>>,
+    /// The baseline beside DeepBRDF: `ipca` (Fig. 9) or `sun2018` (Fig. 8).
+    #[arg(long, value_enum, default_value = "ipca")]
+    pub baseline: Baseline,
+    /// Fit the baseline on this folder of MERL .binary files [default: the bundled
+    /// collections the model was trained on].
     #[arg(long, value_name = "DIR")]
     pub ipca_data: Option<PathBuf>,
-    /// Output folder.
-    #[arg(long, value_name = "DIR", default_value = "results/fig9")]
-    pub out: PathBuf,
+    /// Output folder [default: results/fig9, results/fig8 with `--baseline sun2018`].
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
     #[command(flatten)]
     pub figure: crate::args::figure::FigureArg,
     #[command(flatten)]
     pub cache: CacheArg,
 }
 
-/// IPCA's training data when the model's: the bundled collections of its provenance label
+/// The baseline a figure compares DeepBRDF with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Baseline {
+    /// IPCA (Nielsen et al. 2015): Fig. 9.
+    Ipca,
+    /// Sun et al. 2018's diffuse-specular separation: Fig. 8.
+    Sun2018,
+}
+
+impl Baseline {
+    /// The figure's number, its method's label and its CSV column.
+    fn figure(self) -> (u32, &'static str, &'static str) {
+        match self {
+            Self::Ipca => (9, "IPCA", "relae_ipca"),
+            Self::Sun2018 => (8, deepbrdf_eval::separation::NAME, "relae_sun2018"),
+        }
+    }
+
+    /// The baseline at `k`, fitted on `train`.
+    fn fit(
+        self,
+        train: &Dataset,
+        k: usize,
+        progress: &dyn Progress,
+    ) -> anyhow::Result<Box<dyn Codec>> {
+        let refs: Vec<_> = train.tables.iter().collect();
+        Ok(match self {
+            Self::Ipca => {
+                let basis =
+                    BaselineBasis::fit("IPCA", MappingKind::LogRelative, &refs, k, progress)?;
+                Box::new(Arc::new(basis).codec(k)?)
+            }
+            Self::Sun2018 => SeparatedMethod::default().fit(&refs, &train.names, k, progress)?,
+        })
+    }
+}
+
+/// The baseline's training data when the model's: the bundled collections of its provenance label
 /// (`merl`, or `merl+nielsen2015+...` as `train --add-collections` writes it), loaded as
 /// `train` loaded them (the first as it is, the added ones by [`load_added`]).
 fn model_collections(
@@ -59,12 +109,12 @@ fn model_collections(
     let Ok(collections) = parsed else {
         bail!(
             "the model was trained on '{label}', not bundled collections: give --ipca-data DIR \
-             with its training materials, so that IPCA is fitted on the same data"
+             with its training materials, so that the baseline is fitted on the same data"
         );
     };
     let source = DataSource::Bundled(collections[0]);
     let mut train = Dataset::load(&source, cache, progress)
-        .with_context(|| format!("loading IPCA's training data {}", source.label()))?;
+        .with_context(|| format!("loading the baseline's training data {}", source.label()))?;
     let added = load_added(&collections[1..], cache, progress)?;
     train.names.extend(added.names);
     train.tables.extend(added.tables);
@@ -77,7 +127,7 @@ struct Row {
     material: String,
     noise: f64,
     deepbrdf: f64,
-    ipca: f64,
+    baseline: f64,
 }
 
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
@@ -89,21 +139,37 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let train = match &args.ipca_data {
         Some(dir) => {
             let source = DataSource::Folder(dir.clone());
-            Dataset::load(&source, &cache, progress)
-                .with_context(|| format!("loading IPCA's training data {}", source.label()))?
+            Dataset::load(&source, &cache, progress).with_context(|| {
+                format!("loading the baseline's training data {}", source.label())
+            })?
         }
         None => model_collections(&model.provenance().data_label, &cache, progress)?,
     };
-    let refs: Vec<_> = train.tables.iter().collect();
-    let basis = Arc::new(BaselineBasis::fit("IPCA", MappingKind::LogRelative, &refs, k, progress)?);
-    let ipca = basis.codec(k)?;
+    let (figure, label, column) = args.baseline.figure();
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("results/fig{figure}")));
+    let baseline = args.baseline.fit(&train, k, progress)?;
     let deep = ModelCodec(&model);
     let source = match &args.data {
         Some(dir) => DataSource::Folder(dir.clone()),
         None => DataSource::Bundled(args.collection),
     };
-    let shown = Dataset::load(&source, &cache, progress)
+    let mut shown = Dataset::load(&source, &cache, progress)
         .with_context(|| format!("loading the dataset {}", source.label()))?;
+    if let Some(names) = &args.materials {
+        let mut picked = Dataset { label: shown.label.clone(), names: vec![], tables: vec![] };
+        for name in names {
+            let i = shown.names.iter().position(|n| n == name).with_context(|| {
+                format!(
+                    "--materials: '{name}' is not in {} ({} materials)",
+                    shown.label,
+                    shown.len()
+                )
+            })?;
+            picked.names.push(shown.names[i].clone());
+            picked.tables.push(shown.tables[i].clone());
+        }
+        shown = picked;
+    }
     // Shown materials the representations were fitted to (a model trained with
     // `--add-collections` names them `COLLECTION/NAME`): then the figure is in-sample.
     let seen = shown
@@ -115,13 +181,18 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                     && train.names.contains(&format!("{}/{n}", args.collection.name())))
         })
         .count();
-    let in_sample = (seen > 0).then(|| {
-        format!(
+    let in_sample = (seen > 0).then(|| match args.baseline {
+        Baseline::Ipca => format!(
             "{seen} of the {} shown materials are in the training data of both representations: \
              in-sample, not Fig. 9's generalization (give --model with a model trained on merl \
              alone)",
             shown.len()
-        )
+        ),
+        Baseline::Sun2018 => format!(
+            "{seen} of the {} shown materials are in the training data of both representations: \
+             in-sample, as the paper's Fig. 8",
+            shown.len()
+        ),
     });
     if let Some(note) = &in_sample {
         eprintln!("note: {note}");
@@ -129,18 +200,18 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
 
     let tonemap = Tonemap::default();
     let srgb = |img: &deepbrdf_render::Image| img.to_srgb8(&tonemap, [0, 0, 0]);
-    let (mut originals, mut deeps, mut ipcas, mut rows) = (vec![], vec![], vec![], vec![]);
-    progress.start(4 * shown.len() as u64, "rendering Fig. 9");
+    let (mut originals, mut deeps, mut bases, mut rows) = (vec![], vec![], vec![], vec![]);
+    progress.start(4 * shown.len() as u64, &format!("rendering Fig. {figure}"));
     for (name, table) in shown.names.iter().zip(&shown.tables) {
         let measure = ImageRelae::new(table, &config)?;
         progress.advance(1);
         let noise = measure.noise(table)?;
         progress.advance(1);
         let short = name.rsplit('/').next().unwrap_or(name).to_string();
-        let mut row = Row { material: name.clone(), noise, deepbrdf: 0.0, ipca: 0.0 };
+        let mut row = Row { material: name.clone(), noise, deepbrdf: 0.0, baseline: 0.0 };
         for (label, codec, slot, out) in [
             ("DeepBRDF", &deep as &dyn Codec, &mut row.deepbrdf, &mut deeps),
-            ("IPCA", &ipca as &dyn Codec, &mut row.ipca, &mut ipcas),
+            (label, baseline.as_ref(), &mut row.baseline, &mut bases),
         ] {
             let reconstruction = codec.decode(&codec.encode(table)?)?;
             let image = measure.render(&reconstruction)?;
@@ -153,23 +224,24 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     }
     progress.finish();
     let columns = rows.len() as u32;
-    let tiles: Vec<Tile> = originals.into_iter().chain(deeps).chain(ipcas).collect();
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
+    let tiles: Vec<Tile> = originals.into_iter().chain(deeps).chain(bases).collect();
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     let sheet = SheetConfig { columns, caption_height: 22, font_px: 15, ..Default::default() };
-    contact_sheet(&tiles, &sheet)?.write_figure(&args.out.join("fig9.jpg"))?;
+    let image = format!("fig{figure}.jpg");
+    contact_sheet(&tiles, &sheet)?.write_figure(&out.join(&image))?;
 
     let max_noise = rows.iter().map(|r| r.noise).fold(0.0, f64::max);
-    let mut csv = String::from("material,render_noise,relae_deepbrdf,relae_ipca\n");
+    let mut csv = format!("material,render_noise,relae_deepbrdf,{column}\n");
     let mut md = format!(
-        "Fig. 9 on {} ({} materials), written by `experiments figures-generalize`: DeepBRDF \
-         model {} (k = {k}, trained on {}) and IPCA at k = {k} fitted on {} ({} materials); \
-         rows: as measured, DeepBRDF, IPCA; image RelAE on the preview sphere under sun and sky \
+        "Fig. {figure} on {} ({} materials), written by `experiments figures-generalize`: \
+         DeepBRDF model {} (k = {k}, trained on {}) and {label} at k = {k} fitted on {} ({} \
+         materials); rows: as measured, DeepBRDF, {label}; image RelAE on the preview sphere \
+         under sun and sky \
          ({size} px, {spp} spp, Sobol points, seed {seed}). Render noise: the image RelAE \
          between two renders of the measurement with seeds {seed} and {seed2}, at most \
          {max_noise:.4}; each reconstruction's render shares its random numbers with the \
          measurement's, so its noise is below that.\n\n\
-         ![Fig. 9](fig9.jpg)\n\n| material | render noise | DeepBRDF | IPCA |\n\
+         ![Fig. {figure}]({image})\n\n| material | render noise | DeepBRDF | {label} |\n\
          | --- | ---: | ---: | ---: |\n",
         shown.label,
         shown.len(),
@@ -183,20 +255,24 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         seed2 = config.next_seed().render.seed,
     );
     for r in &rows {
-        writeln!(csv, "{},{:.6},{:.6},{:.6}", r.material, r.noise, r.deepbrdf, r.ipca)?;
-        writeln!(md, "| {} | {:.4} | {:.4} | {:.4} |", r.material, r.noise, r.deepbrdf, r.ipca)?;
+        writeln!(csv, "{},{:.6},{:.6},{:.6}", r.material, r.noise, r.deepbrdf, r.baseline)?;
+        writeln!(
+            md,
+            "| {} | {:.4} | {:.4} | {:.4} |",
+            r.material, r.noise, r.deepbrdf, r.baseline
+        )?;
     }
-    let (d, i) =
-        (finite_mean(rows.iter().map(|r| r.deepbrdf)), finite_mean(rows.iter().map(|r| r.ipca)));
-    let wins = rows.iter().filter(|r| r.deepbrdf < r.ipca).count();
-    writeln!(md, "| **mean** | | **{d:.4}** | **{i:.4}** |")?;
-    writeln!(md, "\nDeepBRDF is below IPCA on {wins} of {} materials.", rows.len())?;
+    let d = finite_mean(rows.iter().map(|r| r.deepbrdf));
+    let b = finite_mean(rows.iter().map(|r| r.baseline));
+    let wins = rows.iter().filter(|r| r.deepbrdf < r.baseline).count();
+    writeln!(md, "| **mean** | | **{d:.4}** | **{b:.4}** |")?;
+    writeln!(md, "\nDeepBRDF is below {label} on {wins} of {} materials.", rows.len())?;
     if let Some(note) = &in_sample {
         writeln!(md, "\n**Note**: {note}.")?;
     }
-    write_atomic(&args.out.join("fig9.csv"), csv.as_bytes())?;
-    write_atomic(&args.out.join("summary.md"), md.as_bytes())?;
+    write_atomic(&out.join(format!("fig{figure}.csv")), csv.as_bytes())?;
+    write_atomic(&out.join("summary.md"), md.as_bytes())?;
     print!("{md}");
-    eprintln!("wrote {}/fig9.jpg, fig9.csv, summary.md", args.out.display());
+    eprintln!("wrote {}/fig{figure}.jpg, fig{figure}.csv, summary.md", out.display());
     Ok(())
 }
