@@ -10,7 +10,7 @@ use deepbrdf_eval::attributes::AttributeMethod;
 use deepbrdf_eval::baseline::BaselineMethod;
 use deepbrdf_eval::deep::DeepMethod;
 use deepbrdf_eval::harness::{self, HarnessConfig, Materials, Measure, Method, Mode};
-use deepbrdf_eval::separation::SeparatedMethod;
+use deepbrdf_eval::separation::{SeparatedMethod, SeparationConfig};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -59,6 +59,10 @@ pub struct Args {
     /// --add-collections nielsen2015,rgl,rgl-measured`.
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     pub add_collections: Vec<Collection>,
+    /// The sun2018 method's diffuse coefficients (1, Fig. 8's setting; 3 keeps each albedo as
+    /// the separation found it, at k + 2 numbers per material in all).
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub sun_diffuse_dims: usize,
     /// The preset of the deepbrdf method.
     #[arg(long, default_value = "slice")]
     pub preset: deepbrdf_model::Preset,
@@ -165,7 +169,10 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     };
     let eval_label = eval.as_ref().map(|e| format!("{} ({} materials)", e.label, e.len()));
     let ggx = AttributeMethod::default();
-    let sun = SeparatedMethod::default();
+    let sun = SeparatedMethod::new(SeparationConfig {
+        diffuse_dims: args.sun_diffuse_dims,
+        ..SeparationConfig::default()
+    });
     let preset = args.preset;
     let models = args.models.clone().unwrap_or_else(|| out.join("models"));
     let deep = DeepMethod::new(
