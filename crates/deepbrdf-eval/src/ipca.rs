@@ -19,13 +19,26 @@ pub const EPSILON: f64 = 1e-3;
 /// [`crate::separation`]) is floored at `rho w = -eps / 2`, so the logarithm stays finite.
 #[inline]
 pub fn cosine_log_relative(rho: f64, rho_ref: f64, w: f64) -> f64 {
-    ((rho * w + EPSILON).max(0.5 * EPSILON) / (rho_ref * w + EPSILON)).ln()
+    cosine_log_relative_eps(rho, rho_ref, w, EPSILON)
 }
 
 /// Inverse of [`cosine_log_relative`]: `rho = ((rho_ref w + eps) exp(y) - eps) / w`.
 #[inline]
 pub fn cosine_log_relative_inverse(y: f64, rho_ref: f64, w: f64) -> f64 {
-    ((rho_ref * w + EPSILON) * y.exp() - EPSILON) / w
+    cosine_log_relative_inverse_eps(y, rho_ref, w, EPSILON)
+}
+
+/// [`cosine_log_relative`] with another `eps` (a separated specular part, whose values near 0
+/// [`crate::separation`] may want weighted less).
+#[inline]
+pub fn cosine_log_relative_eps(rho: f64, rho_ref: f64, w: f64, eps: f64) -> f64 {
+    ((rho * w + eps).max(0.5 * eps) / (rho_ref * w + eps)).ln()
+}
+
+/// Inverse of [`cosine_log_relative_eps`].
+#[inline]
+pub fn cosine_log_relative_inverse_eps(y: f64, rho_ref: f64, w: f64, eps: f64) -> f64 {
+    ((rho_ref * w + eps) * y.exp() - eps) / w
 }
 
 #[cfg(test)]

@@ -37,6 +37,14 @@ pub(super) fn save(b: &BaselineBasis, path: &Path) -> Result<()> {
     if name.len() > MAX_NAME {
         return Err(EvalError::Invalid(format!("basis name longer than {MAX_NAME} bytes")));
     }
+    if let Mapping::LogRelative { epsilon, .. } = b.mapping {
+        if epsilon != crate::ipca::EPSILON {
+            return Err(EvalError::Invalid(format!(
+                "a basis artifact holds IPCA's eps {}, not {epsilon}",
+                crate::ipca::EPSILON
+            )));
+        }
+    }
     let mut out: Vec<u8> = Vec::new();
     out.extend_from_slice(MAGIC);
     let kind: u32 = match b.mapping {

@@ -31,6 +31,9 @@ pub enum Mapping {
         reference: Vec<f32>,
         /// cos(theta_i) cos(theta_o) of each domain cell.
         cos_weight: Vec<f32>,
+        /// eps of the mapping: [`ipca::EPSILON`] (IPCA's and every saved basis'), or another
+        /// for a separated specular part ([`Mapping::with_epsilon`]).
+        epsilon: f64,
     },
 }
 
@@ -82,7 +85,23 @@ impl Mapping {
         if cos_weight.iter().any(|w| !(w.is_finite() && *w > 0.0)) {
             return Err(EvalError::Invalid("IPCA cosine weight not positive on the domain".into()));
         }
-        Ok(Self::LogRelative { reference, cos_weight })
+        Ok(Self::LogRelative { reference, cos_weight, epsilon: ipca::EPSILON })
+    }
+
+    /// The same mapping with `eps` in place of IPCA's (a log-relative mapping; the logarithm
+    /// has none). `eps` must be positive and finite.
+    pub fn with_epsilon(self, eps: f64) -> Result<Self> {
+        if !(eps.is_finite() && eps > 0.0) {
+            return Err(EvalError::Invalid(format!(
+                "the mapping's eps must be positive, got {eps}"
+            )));
+        }
+        Ok(match self {
+            Self::LogRelative { reference, cos_weight, .. } => {
+                Self::LogRelative { reference, cos_weight, epsilon: eps }
+            }
+            Self::Log => Self::Log,
+        })
     }
 
     /// Maps `table` to a row over `domain`. A domain cell that is invalid in `table` gets NaN
@@ -111,11 +130,14 @@ impl Mapping {
                     let rho = f64::from(values[c * CELLS + cell]) - less[c];
                     *o = match self {
                         Self::Log => pca::log_map(rho),
-                        Self::LogRelative { reference, cos_weight } => ipca::cosine_log_relative(
-                            rho,
-                            f64::from(reference[c * n + m]),
-                            f64::from(cos_weight[m]),
-                        ),
+                        Self::LogRelative { reference, cos_weight, epsilon } => {
+                            ipca::cosine_log_relative_eps(
+                                rho,
+                                f64::from(reference[c * n + m]),
+                                f64::from(cos_weight[m]),
+                                *epsilon,
+                            )
+                        }
                     } as f32;
                 }
             });
@@ -150,11 +172,12 @@ impl Mapping {
                 let y = f64::from(row[c * n + m]);
                 let rho = match self {
                     Self::Log => pca::log_unmap(y),
-                    Self::LogRelative { reference, cos_weight } => {
-                        ipca::cosine_log_relative_inverse(
+                    Self::LogRelative { reference, cos_weight, epsilon } => {
+                        ipca::cosine_log_relative_inverse_eps(
                             y,
                             f64::from(reference[c * n + m]),
                             f64::from(cos_weight[m]),
+                            *epsilon,
                         )
                     }
                 };

@@ -74,12 +74,13 @@ impl BaselineBasis {
     /// IPCA's mapping and `k` components fitted to what is left of each training table once
     /// `less[t][c]` is taken off every value of channel c: the specular parts of a
     /// diffuse-specular separation ([`crate::separation`]). `reference` must be their median
-    /// ([`MedianReference::from_remainders`]).
+    /// ([`MedianReference::from_remainders`]); `epsilon` the mapping's eps ([`Mapping::with_epsilon`]).
     pub fn fit_remainders(
         name: &str,
         train: &[&MerlTable],
         less: &[[f64; 3]],
         reference: &MedianReference,
+        epsilon: f64,
         k: usize,
         progress: &dyn Progress,
     ) -> Result<Self> {
@@ -92,7 +93,7 @@ impl BaselineBasis {
             )));
         }
         let domain = Domain::common(train)?;
-        let mapping = Mapping::log_relative(&domain, reference.values())?;
+        let mapping = Mapping::log_relative(&domain, reference.values())?.with_epsilon(epsilon)?;
         Self::fit_mapped(name, domain, mapping, train, less, k, progress)
     }
 
@@ -360,6 +361,30 @@ mod tests {
             assert!(codecs[0].decode(&[0.0, 0.0]).is_err());
             assert!(codecs[0].decode(&[f32::NAN]).is_err());
         }
+    }
+
+    /// Remainders (a constant per channel taken off) round-trip through their own mapping, at
+    /// any eps; an artifact only holds IPCA's eps, and says so.
+    #[test]
+    fn remainders_fit_and_decode_back_and_a_custom_eps_is_not_saved() {
+        let (_, tables) = sparse_set(4);
+        let refs: Vec<&MerlTable> = tables.iter().collect();
+        let less = [[0.01, 0.02, 0.0], [0.0; 3], [0.03, 0.0, 0.01], [0.0, 0.01, 0.0]];
+        let less32: Vec<[f32; 3]> = less.iter().map(|l| l.map(|x| x as f32)).collect();
+        let reference = MedianReference::from_remainders(&refs, &less32).unwrap();
+        let domain = Domain::common(&refs).unwrap();
+        for eps in [crate::ipca::EPSILON, 0.01] {
+            let b = BaselineBasis::fit_remainders("S", &refs, &less, &reference, eps, 3, &Silent)
+                .unwrap();
+            let code = b.encode_less(&tables[2], less[2], 3).unwrap();
+            let back = b.decode_plus(&code, less[2]).unwrap();
+            assert!(max_weighted_error(&tables[2], &back, &domain) < 2e-4, "eps {eps}");
+            let dir = tempfile::tempdir().unwrap();
+            let saved = b.save(&dir.path().join("s.basis"));
+            assert_eq!(saved.is_ok(), eps == crate::ipca::EPSILON, "eps {eps}: {saved:?}");
+        }
+        let mapping = Mapping::log_relative(&domain, reference.values()).unwrap();
+        assert!(mapping.with_epsilon(0.0).is_err());
     }
 
     #[test]

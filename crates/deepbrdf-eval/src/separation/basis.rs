@@ -65,7 +65,8 @@ impl SeparatedBasis {
                 let other = &halves[1 - h];
                 let rows: Vec<Vec<f32>> = other.iter().map(|&m| values[m].clone()).collect();
                 let found: Vec<[f64; 3]> = other.iter().map(|&m| albedos[m]).collect();
-                let search = SearchBasis::fit(&sample, &rows, &found, components)?;
+                let search =
+                    SearchBasis::fit(&sample, &rows, &found, components, config.specular_epsilon)?;
                 let own: Vec<&[f32]> = half.iter().map(|&m| values[m].as_slice()).collect();
                 let own_bounds: Vec<[f64; 3]> = half.iter().map(|&m| bounds[m]).collect();
                 for (&m, a) in half.iter().zip(separate_all(&search, &sample, &own, &own_bounds)) {
@@ -87,7 +88,8 @@ impl SeparatedBasis {
         // The search a new BRDF meets, fitted to all; the training BRDFs are separated by it
         // too, so that encoding one of them finds the albedo its specular part was fitted with.
         let components = config.search_components.min(n - 2);
-        let search = SearchBasis::fit(&sample, &values, &albedos, components)?;
+        let search =
+            SearchBasis::fit(&sample, &values, &albedos, components, config.specular_epsilon)?;
         let all: Vec<&[f32]> = values.iter().map(Vec::as_slice).collect();
         let albedos = separate_all(&search, &sample, &all, &bounds);
         progress.finish();
@@ -101,8 +103,9 @@ impl SeparatedBasis {
         }
         let less_f32: Vec<[f32; 3]> = less.iter().map(|l| l.map(|x| x as f32)).collect();
         let reference = MedianReference::from_remainders(train, &less_f32)?;
+        let eps = config.specular_epsilon;
         let specular =
-            BaselineBasis::fit_remainders(name, train, &less, &reference, specular, progress)?;
+            BaselineBasis::fit_remainders(name, train, &less, &reference, eps, specular, progress)?;
         Ok(Self {
             domain,
             sample,

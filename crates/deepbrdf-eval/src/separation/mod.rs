@@ -33,7 +33,7 @@ pub const NAME: &str = "Sun2018";
 pub const MIN_TRAIN: usize = 4;
 
 /// The settings of the separation.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct SeparationConfig {
     /// Coefficients of the diffuse part (PCA over the training albedos): Fig. 8's 1. With 3
     /// the albedo is kept as found, and a full set of specular components reproduces every
@@ -49,11 +49,21 @@ pub struct SeparationConfig {
     pub iterations: usize,
     /// The search looks at every `stride`-th cell of the domain.
     pub stride: usize,
+    /// eps of the specular part's mapping (IPCA's 0.001 by default): with the Lambertian part
+    /// taken off, much of a specular part is near 0, where a small eps spends components on
+    /// how its logarithm varies.
+    pub specular_epsilon: f64,
 }
 
 impl Default for SeparationConfig {
     fn default() -> Self {
-        Self { diffuse_dims: 1, search_components: 9, iterations: 1, stride: 32 }
+        Self {
+            diffuse_dims: 1,
+            search_components: 9,
+            iterations: 1,
+            stride: 32,
+            specular_epsilon: crate::ipca::EPSILON,
+        }
     }
 }
 
@@ -70,6 +80,12 @@ impl SeparationConfig {
             return Err(EvalError::Invalid(format!(
                 "diffuse dimensions must be 1, 2 or 3, got {}",
                 self.diffuse_dims
+            )));
+        }
+        if !(self.specular_epsilon.is_finite() && self.specular_epsilon > 0.0) {
+            return Err(EvalError::Invalid(format!(
+                "the specular part's eps must be positive, got {}",
+                self.specular_epsilon
             )));
         }
         if self.search_components == 0 || self.iterations == 0 || self.stride == 0 {

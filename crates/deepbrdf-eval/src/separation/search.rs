@@ -9,7 +9,7 @@
 
 use crate::baseline::Domain;
 use crate::error::{EvalError, Result};
-use crate::ipca::{cosine_log_relative, cosine_log_relative_inverse, EPSILON};
+use crate::ipca::{cosine_log_relative_eps, cosine_log_relative_inverse_eps, EPSILON};
 use crate::pca::LinearBasis;
 use deepbrdf_data::merl::{grid::cos_weights, CELLS};
 use deepbrdf_data::{MerlTable, Silent};
@@ -97,6 +97,8 @@ impl Sample {
 pub struct SearchBasis {
     reference: Vec<f32>,
     basis: LinearBasis,
+    /// eps of the specular part's mapping.
+    epsilon: f64,
 }
 
 impl SearchBasis {
@@ -107,6 +109,7 @@ impl SearchBasis {
         values: &[Vec<f32>],
         albedos: &[[f64; 3]],
         components: usize,
+        epsilon: f64,
     ) -> Result<Self> {
         let dim = 3 * sample.len();
         let specular: Vec<Vec<f32>> = values
@@ -133,8 +136,11 @@ impl SearchBasis {
                 deepbrdf_data::mapping::median(&mut at).max(0.0)
             })
             .collect();
-        let rows: Vec<Vec<f32>> =
-            values.iter().zip(albedos).map(|(v, a)| map_row(sample, v, &reference, *a)).collect();
+        let rows: Vec<Vec<f32>> = values
+            .iter()
+            .zip(albedos)
+            .map(|(v, a)| map_row(sample, v, &reference, *a, epsilon))
+            .collect();
         let mean = column_means(&rows, dim);
         let rows: Vec<Vec<f32>> = rows
             .into_iter()
@@ -144,7 +150,7 @@ impl SearchBasis {
             .collect();
         let refs: Vec<&[f32]> = rows.iter().map(Vec::as_slice).collect();
         let basis = LinearBasis::fit(&refs, components, &Silent)?;
-        Ok(Self { reference, basis })
+        Ok(Self { reference, basis, epsilon })
     }
 
     /// The albedo per channel at which `values` is best explained as that Lambertian part
@@ -182,7 +188,8 @@ impl SearchBasis {
         let mut coefficients = vec![0f64; k];
         for (i, &x) in values.iter().enumerate() {
             if x.is_finite() {
-                let y = specular_mapped(x, albedo[i / n], self.reference[i], sample.weights[i % n]);
+                let (r, w) = (self.reference[i], sample.weights[i % n]);
+                let y = specular_mapped(x, albedo[i / n], r, w, self.epsilon);
                 let d = y - f64::from(mean[i]);
                 for (t, &v) in coefficients.iter_mut().zip(&comps[i * k..(i + 1) * k]) {
                     *t += d * f64::from(v);
@@ -201,7 +208,8 @@ impl SearchBasis {
                 .sum();
             let w = sample.weights[i % n];
             let y = f64::from(mean[i]) + along;
-            let specular = cosine_log_relative_inverse(y, f64::from(self.reference[i]), w);
+            let r = f64::from(self.reference[i]);
+            let specular = cosine_log_relative_inverse_eps(y, r, w, self.epsilon);
             let rho_hat = (albedo[i / n] / PI + specular).max(0.0);
             let e = ((rho_hat * w + EPSILON) / (f64::from(x) * w + EPSILON)).ln();
             error += e * e;
@@ -249,7 +257,7 @@ fn minimise(cost: impl Fn(f64) -> f64, upper: f64) -> f64 {
 }
 
 /// The mapped specular row of sample `values` with albedo `a` (NaN where there is no value).
-fn map_row(sample: &Sample, values: &[f32], reference: &[f32], a: [f64; 3]) -> Vec<f32> {
+fn map_row(sample: &Sample, values: &[f32], reference: &[f32], a: [f64; 3], eps: f64) -> Vec<f32> {
     let n = sample.len();
     (0..3 * n)
         .map(|i| {
@@ -257,15 +265,15 @@ fn map_row(sample: &Sample, values: &[f32], reference: &[f32], a: [f64; 3]) -> V
             if !x.is_finite() {
                 return f32::NAN;
             }
-            specular_mapped(x, a[i / n], reference[i], sample.weights[i % n]) as f32
+            specular_mapped(x, a[i / n], reference[i], sample.weights[i % n], eps) as f32
         })
         .collect()
 }
 
 /// The specular part `rho - albedo / pi` of a value, mapped as IPCA maps a value (weight `w`).
 #[inline]
-fn specular_mapped(rho: f32, albedo: f64, reference: f32, w: f64) -> f64 {
-    cosine_log_relative(f64::from(rho) - albedo / PI, f64::from(reference), w)
+fn specular_mapped(rho: f32, albedo: f64, reference: f32, w: f64, eps: f64) -> f64 {
+    cosine_log_relative_eps(f64::from(rho) - albedo / PI, f64::from(reference), w, eps)
 }
 
 /// The mean of each column over the rows where it is not NaN (0 where it is NaN in all).

@@ -63,6 +63,9 @@ pub struct Args {
     /// the separation found it, at k + 2 numbers per material in all).
     #[arg(long, value_name = "N", default_value_t = 1)]
     pub sun_diffuse_dims: usize,
+    /// The sun2018 method's eps in the mapping of the specular part (IPCA's 0.001 by default).
+    #[arg(long, value_name = "EPS", default_value_t = deepbrdf_eval::ipca::EPSILON)]
+    pub sun_specular_epsilon: f64,
     /// The preset of the deepbrdf method.
     #[arg(long, default_value = "slice")]
     pub preset: deepbrdf_model::Preset,
@@ -171,6 +174,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let ggx = AttributeMethod::default();
     let sun = SeparatedMethod::new(SeparationConfig {
         diffuse_dims: args.sun_diffuse_dims,
+        specular_epsilon: args.sun_specular_epsilon,
         ..SeparationConfig::default()
     });
     let preset = args.preset;
