@@ -37,6 +37,20 @@ def write_merl(path: PathLike, table: ArrayLike) -> None:
 def read_bsdf(path: PathLike) -> Table:
     """Reads an RGL `.bsdf` measurement tabulated on the MERL grid (`experiments convert`)."""
 
+def write_bsdf(
+    path: PathLike,
+    table: Table,
+    *,
+    description: str = "table",
+    theta_i: Optional[int] = None,
+    ndf: Optional[int] = None,
+    vndf: Optional[int] = None,
+    rgb: Optional[int] = None,
+) -> None:
+    """Writes a table as an isotropic RGB RGL `.bsdf` file (Mitsuba 3's and pbrt-v4's
+    `measured` materials read it), byte for byte as `experiments export-bsdf` writes it for the
+    same description and resolutions (its defaults when None)."""
+
 def bundled(name: str) -> Table:
     """A bundled material by name (`chrome`, `merl/chrome`, `rgl/cardboard_rgb`,
     `rgl-measured/paper_white_rgb`), tabulated on first use and cached. The `merl`,

@@ -1,11 +1,12 @@
 //! Reading and writing measured BRDFs from Python: MERL `.binary` files, RGL `.bsdf`
-//! measurements tabulated on the MERL grid, the bundled materials (`deepbrdf_data`).
+//! measurements tabulated on the MERL grid and tables exported as `.bsdf` files, the bundled
+//! materials (`deepbrdf_data`).
 use crate::arrays::{table_in, table_out};
 use crate::errors::{py_err, value_error};
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::cache::Cache;
 use deepbrdf_data::dataset::load_bundled_material;
-use deepbrdf_data::rgl::{tabulate, RglBrdf};
+use deepbrdf_data::rgl::{export, tabulate, ExportResolution, RglBrdf};
 use pyo3::prelude::*;
 use std::path::PathBuf;
 
@@ -42,6 +43,38 @@ pub fn read_bsdf(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyAny>> {
     let table =
         py.detach(|| RglBrdf::read(&path).and_then(|brdf| tabulate(&brdf))).map_err(py_err)?;
     table_out(py, table)
+}
+
+/// write_bsdf(path, table, *, description="table", theta_i=None, ndf=None, vndf=None,
+/// rgb=None) -> None
+///
+/// Writes a table (shape (3, 90, 90, 180), 1/sr) as an isotropic RGB tensor file of the RGL
+/// format (Dupuy and Jakob 2018), which Mitsuba 3's and pbrt-v4's `measured` materials read,
+/// atomically, byte for byte as `experiments export-bsdf` writes it for the same description
+/// (the CLI names it after the material) and resolutions (its defaults when None). ValueError
+/// for a table or resolution the exporter refuses, OSError for the file.
+#[pyfunction]
+#[pyo3(signature = (path, table, *, description="table", theta_i=None, ndf=None, vndf=None, rgb=None))]
+pub fn write_bsdf(
+    py: Python<'_>,
+    path: PathBuf,
+    table: &Bound<'_, PyAny>,
+    description: &str,
+    theta_i: Option<usize>,
+    ndf: Option<usize>,
+    vndf: Option<usize>,
+    rgb: Option<usize>,
+) -> PyResult<()> {
+    let table = table_in(table, "table")?;
+    let default = ExportResolution::default();
+    let resolution = ExportResolution {
+        theta_i: theta_i.unwrap_or(default.theta_i),
+        ndf: ndf.unwrap_or(default.ndf),
+        vndf: vndf.unwrap_or(default.vndf),
+        rgb: rgb.unwrap_or(default.rgb),
+    };
+    py.detach(|| export(&table, description, &resolution, &path).and_then(|f| f.write(&path)))
+        .map_err(py_err)
 }
 
 /// bundled(name) -> numpy.ndarray

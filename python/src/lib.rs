@@ -18,6 +18,7 @@ fn deepbrdf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(data::read_merl, m)?)?;
     m.add_function(wrap_pyfunction!(data::write_merl, m)?)?;
     m.add_function(wrap_pyfunction!(data::read_bsdf, m)?)?;
+    m.add_function(wrap_pyfunction!(data::write_bsdf, m)?)?;
     m.add_function(wrap_pyfunction!(data::bundled, m)?)?;
     m.add_function(wrap_pyfunction!(data::bundled_names, m)?)?;
     m.add_function(wrap_pyfunction!(render::render, m)?)?;

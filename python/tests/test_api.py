@@ -114,6 +114,10 @@ def test_bad_arrays_are_value_errors(model, chrome):
         deepbrdf.render(chrome, size=0)
     with pytest.raises(ValueError):
         deepbrdf.write_png("x.png", np.zeros((4, 4)))
+    with pytest.raises(ValueError):
+        deepbrdf.write_bsdf("x.bsdf", chrome, rgb=0)
+    with pytest.raises(ValueError):
+        deepbrdf.write_bsdf("x.bsdf", np.zeros((3, 90, 90)))
 
 
 def test_bad_files_are_os_errors_naming_the_file(tmp_path):
@@ -133,6 +137,8 @@ def test_bad_files_are_os_errors_naming_the_file(tmp_path):
         deepbrdf.Model.load(tmp_path / "no-model")
     with pytest.raises(OSError):
         deepbrdf.write_merl(tmp_path / "no-dir" / "x.binary", deepbrdf.bundled("chrome"))
+    with pytest.raises(OSError):
+        deepbrdf.write_bsdf(tmp_path / "no-dir" / "x.bsdf", deepbrdf.bundled("chrome"))
 
 
 def test_long_calls_release_the_gil(model, chrome):

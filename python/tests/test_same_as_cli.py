@@ -82,3 +82,17 @@ def test_read_bsdf_equals_convert(experiments, tmp_path):
     np.testing.assert_array_equal(
         deepbrdf.read_merl(tmp_path / "cli.binary"), deepbrdf.read_bsdf(bsdf)
     )
+
+
+def test_write_bsdf_equals_export_bsdf(experiments, chrome, tmp_path):
+    run(experiments, "export-bsdf", "chrome", "-o", tmp_path / "cli.bsdf")
+    deepbrdf.write_bsdf(tmp_path / "py.bsdf", chrome, description="chrome")
+    same_bytes(tmp_path / "cli.bsdf", tmp_path / "py.bsdf")
+    run(experiments, "export-bsdf", "chrome", "--theta-i", "4", "--rgb", "16",
+        "-o", tmp_path / "cli-small.bsdf")
+    deepbrdf.write_bsdf(tmp_path / "py-small.bsdf", chrome, description="chrome", theta_i=4,
+                        rgb=16)
+    same_bytes(tmp_path / "cli-small.bsdf", tmp_path / "py-small.bsdf")
+    # What it writes reads back as a table close to the one written.
+    back = deepbrdf.read_bsdf(tmp_path / "py.bsdf")
+    assert back.shape == chrome.shape
