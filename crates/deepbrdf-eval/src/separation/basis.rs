@@ -27,8 +27,6 @@ pub struct SeparatedBasis {
     specular: BaselineBasis,
     /// The albedos the separation found for the training BRDFs, in their order.
     training_albedos: Vec<[f64; 3]>,
-    /// Alternations run before the albedos settled (or the configured maximum).
-    iterations: usize,
 }
 
 impl SeparatedBasis {
@@ -48,6 +46,7 @@ impl SeparatedBasis {
         let domain = Domain::common(train)?;
         let sample = Sample::new(&domain, config.stride)?;
         let values: Vec<Vec<f32>> = train.iter().map(|t| sample.values(t)).collect();
+        let all: Vec<&[f32]> = values.iter().map(Vec::as_slice).collect();
         // Each half of the training set is separated against a basis fitted to the other, so
         // a BRDF's own split never shapes the basis that judges it (a basis fitted to all of
         // them explains each one's current split, and the albedos creep instead of moving).
@@ -57,17 +56,15 @@ impl SeparatedBasis {
         let bounds: Vec<[f64; 3]> = train.iter().map(|t| lowest_albedos(&domain, t)).collect();
         let mut albedos = bounds.clone();
         progress.start(config.iterations as u64, "separating diffuse and specular parts");
-        let mut iterations = 0;
         for _ in 0..config.iterations {
-            iterations += 1;
             let mut next = albedos.clone();
             for (h, half) in halves.iter().enumerate() {
                 let other = &halves[1 - h];
-                let rows: Vec<Vec<f32>> = other.iter().map(|&m| values[m].clone()).collect();
+                let rows: Vec<&[f32]> = other.iter().map(|&m| all[m]).collect();
                 let found: Vec<[f64; 3]> = other.iter().map(|&m| albedos[m]).collect();
                 let search =
                     SearchBasis::fit(&sample, &rows, &found, components, config.specular_epsilon)?;
-                let own: Vec<&[f32]> = half.iter().map(|&m| values[m].as_slice()).collect();
+                let own: Vec<&[f32]> = half.iter().map(|&m| all[m]).collect();
                 let own_bounds: Vec<[f64; 3]> = half.iter().map(|&m| bounds[m]).collect();
                 for (&m, a) in half.iter().zip(separate_all(&search, &sample, &own, &own_bounds)) {
                     next[m] = a;
@@ -89,8 +86,7 @@ impl SeparatedBasis {
         // too, so that encoding one of them finds the albedo its specular part was fitted with.
         let components = config.search_components.min(n - 2);
         let search =
-            SearchBasis::fit(&sample, &values, &albedos, components, config.specular_epsilon)?;
-        let all: Vec<&[f32]> = values.iter().map(Vec::as_slice).collect();
+            SearchBasis::fit(&sample, &all, &albedos, components, config.specular_epsilon)?;
         let albedos = separate_all(&search, &sample, &all, &bounds);
         progress.finish();
         let rows: Vec<Vec<f32>> =
@@ -106,15 +102,7 @@ impl SeparatedBasis {
         let eps = config.specular_epsilon;
         let specular =
             BaselineBasis::fit_remainders(name, train, &less, &reference, eps, specular, progress)?;
-        Ok(Self {
-            domain,
-            sample,
-            search,
-            diffuse,
-            specular,
-            training_albedos: albedos,
-            iterations,
-        })
+        Ok(Self { domain, sample, search, diffuse, specular, training_albedos: albedos })
     }
 
     /// Diffuse coefficients stored per BRDF.
@@ -130,11 +118,6 @@ impl SeparatedBasis {
     /// The albedos the separation found for the training BRDFs (before the diffuse PCA).
     pub fn training_albedos(&self) -> &[[f64; 3]] {
         &self.training_albedos
-    }
-
-    /// Alternations of search and fit the separation ran.
-    pub fn iterations(&self) -> usize {
-        self.iterations
     }
 
     /// The diffuse albedo per channel the separation finds for `table`.

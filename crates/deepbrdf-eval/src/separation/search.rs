@@ -1,6 +1,7 @@
 //! The diffuse search of Sun et al. 2018's separation: for one BRDF, the Lambertian albedo per
-//! channel whose remainder, the specular part, is best explained by a low-dimensional basis of
-//! the collection's specular parts (the residual of its projection, smallest).
+//! channel at which the BRDF is best explained as that Lambertian part plus a low-dimensional
+//! basis' reconstruction of the rest, the basis that of the collection's specular parts
+//! ([`SearchBasis::error`]).
 //!
 //! The search looks at a regular sample of the domain's cells ([`Sample`]): one albedo per
 //! channel is a three-number question, and every `stride`-th cell answers it as well as all of
@@ -106,33 +107,23 @@ impl SearchBasis {
     /// row per material) with diffuse albedos `albedos`.
     pub fn fit(
         sample: &Sample,
-        values: &[Vec<f32>],
+        values: &[&[f32]],
         albedos: &[[f64; 3]],
         components: usize,
         epsilon: f64,
     ) -> Result<Self> {
-        let dim = 3 * sample.len();
-        let specular: Vec<Vec<f32>> = values
-            .iter()
-            .zip(albedos)
-            .map(|(v, a)| {
-                (0..dim)
-                    .map(|i| {
-                        let x = v[i];
-                        if x.is_finite() {
-                            (f64::from(x) - a[i / sample.len()] / PI) as f32
-                        } else {
-                            f32::NAN
-                        }
-                    })
-                    .collect()
-            })
-            .collect();
+        let n = sample.len();
+        let dim = 3 * n;
+        // The mapping's reference: the median of the specular parts, value by value.
         let reference: Vec<f32> = (0..dim)
             .into_par_iter()
             .map(|i| {
-                let mut at: Vec<f32> =
-                    specular.iter().map(|s| s[i]).filter(|x| x.is_finite()).collect();
+                let mut at: Vec<f32> = values
+                    .iter()
+                    .zip(albedos)
+                    .filter(|(v, _)| v[i].is_finite())
+                    .map(|(v, a)| (f64::from(v[i]) - a[i / n] / PI) as f32)
+                    .collect();
                 deepbrdf_data::mapping::median(&mut at).max(0.0)
             })
             .collect();
@@ -154,9 +145,9 @@ impl SearchBasis {
     }
 
     /// The albedo per channel at which `values` is best explained as that Lambertian part
-    /// plus the basis' reconstruction of the rest ([`SearchBasis::error`]): the three bounds
-    /// scaled together, then each channel in turn over `[0, bounds]` ([`lowest_albedos`]; a grid, then golden sections around its best point), from the
-    /// largest albedo that leaves no specular value below zero (the bound), [`SWEEPS`] times.
+    /// plus the basis' reconstruction of the rest ([`SearchBasis::error`]), within `[0,
+    /// bounds]` ([`lowest_albedos`]): the three bounds scaled together first, then each
+    /// channel in turn, [`SWEEPS`] times (each a grid, then golden sections round its best).
     pub fn separate(&self, sample: &Sample, values: &[f32], bounds: [f64; 3]) -> [f64; 3] {
         // First all channels together, as a fraction of their bounds: one channel searched
         // while the others sit at their bounds sees the wrong landscape.

@@ -1,7 +1,7 @@
 //! `experiments baselines`: the PCA and IPCA baselines of §4 (Hu et al. 2020) and Sun et al.
-//! 2018's separation (Fig. 8) through the
-//! evaluation harness: fit, encode/decode every material at each k, measure, print the summary
-//! table and write the results folder (CSV, markdown, Fig. 3 / Fig. 7 style plots).
+//! 2018's separation (Fig. 8) through the evaluation harness: fit, encode/decode every material
+//! at each k, measure, print the summary table and write the results folder (CSV, markdown,
+//! Fig. 3 / Fig. 7 style plots).
 use crate::args::data::DataArgs;
 use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
@@ -49,9 +49,8 @@ pub struct Args {
     pub measures: Vec<Measure>,
     /// Methods (comma-separated): pca, ipca, sun2018 (Sun et al. 2018's diffuse-specular
     /// separation, Fig. 8: 1 diffuse + k - 1 specular coefficients), ggx (the 7-number
-    /// Lambertian + GGX attribute fit,
-    /// `deepbrdf_eval::attributes`; needs --k 7), deepbrdf (trained with --preset into
-    /// --models, or loaded from there when finished).
+    /// Lambertian + GGX attribute fit, `deepbrdf_eval::attributes`; needs --k 7), deepbrdf
+    /// (trained with --preset into --models, or loaded from there when finished).
     #[arg(long, value_name = "NAME,...", value_delimiter = ',', default_value = "pca,ipca")]
     pub methods: Vec<String>,
     /// Train every method on these bundled collections too, in every fold, and never score

@@ -19,8 +19,8 @@ use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::dataset::{DataSource, Dataset};
 use deepbrdf_data::files::write_atomic;
 use deepbrdf_data::Progress;
-use deepbrdf_eval::baseline::{BaselineBasis, MappingKind};
-use deepbrdf_eval::harness::{Codec, Method as _};
+use deepbrdf_eval::baseline::BaselineMethod;
+use deepbrdf_eval::harness::{Codec, Method};
 use deepbrdf_eval::metrics::{relae, ImageRelae};
 use deepbrdf_eval::separation::SeparatedMethod;
 use deepbrdf_eval::stats::finite_mean;
@@ -29,7 +29,6 @@ use deepbrdf_render::sheet::{contact_sheet, SheetConfig, Tile};
 use deepbrdf_render::Tonemap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
-use std::sync::Arc;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -86,14 +85,11 @@ impl Baseline {
         progress: &dyn Progress,
     ) -> anyhow::Result<Box<dyn Codec>> {
         let refs: Vec<_> = train.tables.iter().collect();
-        Ok(match self {
-            Self::Ipca => {
-                let basis =
-                    BaselineBasis::fit("IPCA", MappingKind::LogRelative, &refs, k, progress)?;
-                Box::new(Arc::new(basis).codec(k)?)
-            }
-            Self::Sun2018 => SeparatedMethod::default().fit(&refs, &train.names, k, progress)?,
-        })
+        let method: Box<dyn Method> = match self {
+            Self::Ipca => Box::new(BaselineMethod::ipca()),
+            Self::Sun2018 => Box::new(SeparatedMethod::default()),
+        };
+        Ok(method.fit(&refs, &train.names, k, progress)?)
     }
 }
 
@@ -147,7 +143,6 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     };
     let (figure, label, column) = args.baseline.figure();
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("results/fig{figure}")));
-    let baseline = args.baseline.fit(&train, k, progress)?;
     let deep = ModelCodec(&model);
     let source = match &args.data {
         Some(dir) => DataSource::Folder(dir.clone()),
@@ -158,18 +153,20 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     if let Some(names) = &args.materials {
         let mut picked = Dataset { label: shown.label.clone(), names: vec![], tables: vec![] };
         for name in names {
-            let i = shown.names.iter().position(|n| n == name).with_context(|| {
+            let table = shown.get(name).with_context(|| {
                 format!(
                     "--materials: '{name}' is not in {} ({} materials)",
                     shown.label,
                     shown.len()
                 )
             })?;
-            picked.names.push(shown.names[i].clone());
-            picked.tables.push(shown.tables[i].clone());
+            picked.names.push(name.clone());
+            picked.tables.push(table.clone());
         }
         shown = picked;
     }
+    // Fitted once the materials to show are known (a wrong name costs no fit).
+    let baseline = args.baseline.fit(&train, k, progress)?;
     // Shown materials the representations were fitted to (a model trained with
     // `--add-collections` names them `COLLECTION/NAME`): then the figure is in-sample.
     let seen = shown
