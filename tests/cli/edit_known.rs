@@ -1,13 +1,14 @@
 //! `train --corpus [--held-passes N]`, `train-regressor --corpus` and `edit-known` end to end with a tiny model on
-//! three synthetic materials and a few corpus materials: the corpus materials join the training
-//! set, and every known-answer edit is scored for each of the eight methods, the analytic edit
-//! ending nearer the answer than the unedited material.
+//! four synthetic materials and a few corpus materials: the corpus materials join the training
+//! set, and every known-answer edit is scored for each of the nine methods (Sun et al. 2018's
+//! split fitted to the four), the analytic edit ending nearer the answer than the unedited
+//! material.
 use crate::util::{self, s};
 
 #[test]
 fn corpus_training_and_known_answer_edits() {
     let dir = tempfile::tempdir().unwrap();
-    let data = util::write_data(dir.path(), 3);
+    let data = util::write_data(dir.path(), 4);
     let ok = |args: &[&str]| {
         let out = util::run_ok(dir.path(), args);
         (util::stdout(&out), util::stderr(&out))
@@ -32,7 +33,7 @@ fn corpus_training_and_known_answer_edits() {
         "--out",
         &s(&run),
     ]);
-    assert!(err.contains("(5 BRDFs)") && err.contains("corpus(2 of corpus.jsonl)"), "{err}");
+    assert!(err.contains("(6 BRDFs)") && err.contains("corpus(2 of corpus.jsonl)"), "{err}");
     let saved = std::fs::read_to_string(run.join("train_config.json")).unwrap();
     assert!(saved.contains("\"held_passes\": 2"), "{saved}");
     let model = s(&run);
@@ -64,7 +65,7 @@ fn corpus_training_and_known_answer_edits() {
         "--out",
         &s(&out),
         "--methods",
-        "analytic,stretch,deepbrdf-residual,deepbrdf-paper,ipca-residual,deepbrdf-transfer,deepbrdf-transfer-paper,ipca-transfer",
+        "analytic,stretch,deepbrdf-residual,deepbrdf-paper,ipca-residual,deepbrdf-transfer,deepbrdf-transfer-paper,ipca-transfer,sun2018-stretch",
     ]);
     assert!(printed.contains("| analytic | **all** |"), "{printed}");
     let csv = std::fs::read_to_string(out.join("known.csv")).unwrap();
@@ -78,6 +79,7 @@ fn corpus_training_and_known_answer_edits() {
         "DeepBRDF transfer",
         "DeepBRDF transfer (paper)",
         "IPCA transfer",
+        "stretch on Sun2018's split",
     ];
     assert!(!rows.is_empty() && rows.len() % methods.len() == 0, "{csv}");
     for method in methods {

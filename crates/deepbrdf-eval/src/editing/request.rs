@@ -114,6 +114,15 @@ impl Edit {
         }
     }
 
+    /// The recolour of the editing suites: the diffuse albedo `diffuse`'s channels rotated (red
+    /// takes blue's value, green red's, blue green's), a change of hue at the same values.
+    pub fn rotated_diffuse(diffuse: [f64; 3]) -> Self {
+        Self {
+            diffuse: Some(ColourEdit::Set([diffuse[2], diffuse[0], diffuse[1]])),
+            ..Self::default()
+        }
+    }
+
     /// The edited attributes of `a`, checked.
     pub fn apply(&self, a: &Attributes) -> Result<Attributes> {
         let roughness = match self.roughness {

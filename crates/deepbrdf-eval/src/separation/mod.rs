@@ -15,9 +15,11 @@
 //! [`SeparationConfig`]'s, with their reasons.
 
 mod basis;
+mod edit;
 mod search;
 
 pub use basis::SeparatedBasis;
+pub use edit::separated_attributes;
 pub use search::{lowest_albedos, Sample, SearchBasis};
 
 use crate::baseline::{max_k, SharedEncoding};

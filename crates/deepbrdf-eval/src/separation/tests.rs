@@ -1,6 +1,8 @@
 use super::search::lowest_albedos;
 use super::*;
+use crate::attributes::Attributes;
 use crate::baseline::Domain;
+use crate::editing::{directional_albedo, stretch_edit, ColourEdit, Edit};
 use deepbrdf_data::merl::{grid::cos_weights, CELLS};
 use deepbrdf_data::testing::analytic::{ggx, tabulate, Ggx};
 use deepbrdf_data::testing::sparse_set;
@@ -70,6 +72,22 @@ fn on_lambertian_plus_ggx_materials_it_improves_on_the_smallest_value_estimate()
         "median error {found} (the smallest value's {start})"
     );
     assert!(err < 0.02, "held out: found {held_out:?}, truth {:?}", lobes[24].diffuse);
+
+    // Halving its diffuse part on the split gives the material with half the albedo, whatever
+    // albedo the analytic fit would have started from.
+    let lobe = &lobes[24];
+    let fitted = Attributes { diffuse: [0.0; 3], specular: lobe.f0, roughness: lobe.alpha };
+    let halve = Edit { diffuse: Some(ColourEdit::Scale(0.5)), ..Edit::default() };
+    let split = separated_attributes(&basis, &tables[24], &fitted);
+    let asked = halve.apply(&split).unwrap();
+    let edited = stretch_edit(&tables[24], &split, &asked).unwrap();
+    let answer = lambert_ggx_table(&Ggx { diffuse: lobe.diffuse.map(|d| d / 2.0), ..*lobe });
+    for theta in [0.0f64, 60.0] {
+        let got = directional_albedo(&edited, theta.to_radians());
+        let want = directional_albedo(&answer, theta.to_radians());
+        let worst = got.iter().zip(&want).map(|(g, w)| (g - w).abs() / w).fold(0.0, f64::max);
+        assert!(worst < 0.02, "at {theta} deg: {got:?} against {want:?} (asked {asked:?})");
+    }
 }
 
 /// Largest |rho - rho_hat| cos_i cos_o over the domain.

@@ -16,8 +16,9 @@ use deepbrdf_data::corpus::{self, Material};
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::attributes::{Attributes, FitConfig};
 use deepbrdf_eval::editing::known::{self, KnownEdit};
-use deepbrdf_eval::editing::{judge_edit, ColourEdit, Edit, Lobe, ScalarEdit};
+use deepbrdf_eval::editing::{judge_edit, stretch_edit, ColourEdit, Edit, Lobe, ScalarEdit};
 use deepbrdf_eval::metrics::ImageRelaeConfig;
+use deepbrdf_eval::separation::{self, separated_attributes, SeparatedBasis, SeparationConfig};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -48,7 +49,8 @@ pub struct Args {
     /// Epochs of the IPCA regressor when none is saved [default: the library's].
     #[arg(long)]
     pub epochs: Option<usize>,
-    /// The materials IPCA is fitted to (and its regressor trained on, when none is saved).
+    /// The materials IPCA and Sun et al. 2018's separation are fitted to (and IPCA's regressor
+    /// trained on, when none is saved).
     #[command(flatten)]
     pub data: DataArgs,
 }
@@ -72,6 +74,9 @@ pub enum Method {
     DeepbrdfTransferPaper,
     /// IPCA's residual edit carried onto the table.
     IpcaTransfer,
+    /// The stretch edit on Sun et al. 2018's diffuse-specular split, fitted to `--data`
+    /// (`deepbrdf_eval::separation::separated_attributes`).
+    Sun2018Stretch,
 }
 
 impl Method {
@@ -84,7 +89,7 @@ impl Method {
     fn mode(self) -> EditMode {
         match self {
             Self::Analytic => EditMode::Analytic,
-            Self::Stretch => EditMode::Stretch,
+            Self::Stretch | Self::Sun2018Stretch => EditMode::Stretch,
             Self::DeepbrdfResidual | Self::IpcaResidual => EditMode::Residual,
             Self::DeepbrdfPaper | Self::DeepbrdfTransferPaper => EditMode::Paper,
             Self::DeepbrdfTransfer | Self::IpcaTransfer => EditMode::Transfer,
@@ -102,6 +107,7 @@ impl Method {
             Self::DeepbrdfTransfer => "DeepBRDF transfer",
             Self::DeepbrdfTransferPaper => "DeepBRDF transfer (paper)",
             Self::IpcaTransfer => "IPCA transfer",
+            Self::Sun2018Stretch => "stretch on Sun2018's split",
         }
     }
 }
@@ -112,6 +118,9 @@ struct Case {
     edit: Edit,
     answer: Material,
 }
+
+/// The suite's recolour: the diffuse channels rotated, asked of the albedo an edit starts from.
+const RECOLOUR: &str = "recolour";
 
 /// The suite's edits of `material` (fitted attributes `fitted`).
 fn cases(material: &Material, fitted: &Attributes) -> Vec<Case> {
@@ -140,8 +149,8 @@ fn cases(material: &Material, fitted: &Attributes) -> Vec<Case> {
             answer: material.specular_scaled(0.5),
         },
         Case {
-            name: "recolour",
-            edit: Edit { diffuse: Some(ColourEdit::Set([d[2], d[0], d[1]])), ..Edit::default() },
+            name: RECOLOUR,
+            edit: Edit::rotated_diffuse(d),
             answer: material.recoloured([known[2], known[0], known[1]]),
         },
     ]
@@ -170,28 +179,41 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let k = model.k();
     let fit = FitConfig::default();
 
+    // The training materials, for IPCA and the separation when either is asked for.
+    let wants = |f: &dyn Fn(Method) -> bool| args.methods.iter().any(|&m| f(m));
+    let set = match wants(&|m| m.ipca() || m == Method::Sun2018Stretch) {
+        true => Some(args.data.load(progress)?),
+        false => None,
+    };
+    // Sun et al. 2018's split, fitted to them (its search basis is what a split needs; one
+    // specular component is kept for the representation it also builds).
+    let separation = match (&set, wants(&|m| m == Method::Sun2018Stretch)) {
+        (Some(set), true) => {
+            let refs: Vec<&MerlTable> = set.tables.iter().collect();
+            let config = SeparationConfig::default();
+            Some(SeparatedBasis::fit(separation::NAME, &config, &refs, 1, progress)?)
+        }
+        _ => None,
+    };
     // IPCA at the model's k on the training materials, with its regressor, when asked for.
-    let ipca =
-        match args.methods.iter().any(|m| matches!(m, Method::IpcaResidual | Method::IpcaTransfer))
-        {
-            true => {
-                let set = args.data.load(progress)?;
-                let attrs = editing::attributes_of_all(&set, &fit, progress)?;
-                let reg_dir = editing::regressor_dir(&model_dir, args.editor.regressor.as_deref());
-                let scratch = args.out.join("ipca-regressor");
-                Some(editing::ipca_editor(
-                    &reg_dir,
-                    &set,
-                    &attrs,
-                    k,
-                    args.epochs,
-                    &scratch,
-                    progress,
-                    &device,
-                )?)
-            }
-            false => None,
-        };
+    let ipca = match set.as_ref().filter(|_| wants(&Method::ipca)) {
+        Some(set) => {
+            let attrs = editing::attributes_of_all(&set, &fit, progress)?;
+            let reg_dir = editing::regressor_dir(&model_dir, args.editor.regressor.as_deref());
+            let scratch = args.out.join("ipca-regressor");
+            Some(editing::ipca_editor(
+                &reg_dir,
+                set,
+                &attrs,
+                k,
+                args.epochs,
+                &scratch,
+                progress,
+                &device,
+            )?)
+        }
+        None => None,
+    };
     let deep_codec = ModelCodec(&model);
     let deep = Space { codec: &deep_codec, regressor: &deep_regressor };
     let ipca_space = ipca.as_ref().map(|(codec, regressor)| Space { codec, regressor });
@@ -208,6 +230,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         let deep_latent = deep.codec.encode(&table)?;
         let ipca_latent = ipca_space.as_ref().map(|s| s.codec.encode(&table)).transpose()?;
         let lobe = Lobe::of(&table).ok();
+        let split = separation.as_ref().map(|b| separated_attributes(b, &table, &fitted));
         for case in cases(&material, &fitted) {
             if case.edit.apply(&fitted).is_err() || !answer_is_exact(&material, &case) {
                 skipped += 1;
@@ -216,6 +239,14 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             let answer =
                 case.answer.table().with_context(|| format!("tabulating {name} {}", case.name))?;
             let edit_by = |method: Method| -> anyhow::Result<MerlTable> {
+                if method == Method::Sun2018Stretch {
+                    let split = split.as_ref().context("the separation was not fitted")?;
+                    let edit = match case.name {
+                        RECOLOUR => Edit::rotated_diffuse(split.diffuse),
+                        _ => case.edit,
+                    };
+                    return Ok(stretch_edit(&table, split, &edit.apply(split)?)?);
+                }
                 let (space, latent) = match method.ipca() {
                     false => (&deep, &deep_latent),
                     true => ipca_space

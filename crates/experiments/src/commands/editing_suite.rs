@@ -65,8 +65,9 @@ pub fn lobe_summary(rows: &[SuiteRow]) -> String {
 
 /// The suite's (representation, mode) pairs, in the order of its tables: each representation's
 /// paper and residual edits and the residual edit carried onto the table (`Space::transfer`),
-/// and the two edits without a network, analytic and stretch.
-pub const SUITE_METHODS: [(&str, &str); 8] = [
+/// and the edits without a network: analytic, stretch, and stretch on Sun et al. 2018's split
+/// (where the suite is given the separation's data).
+pub const SUITE_METHODS: [(&str, &str); 9] = [
     ("DeepBRDF", "paper"),
     ("DeepBRDF", "residual"),
     ("DeepBRDF", "transfer"),
@@ -75,4 +76,9 @@ pub const SUITE_METHODS: [(&str, &str); 8] = [
     ("IPCA", "transfer"),
     ("analytic", "-"),
     ("stretch", "-"),
+    (SEPARATED, "-"),
 ];
+
+/// The suite's name of the stretch edit on Sun et al. 2018's split
+/// (`deepbrdf_eval::separation::separated_attributes`, then the stretch edit).
+pub const SEPARATED: &str = "stretch on Sun2018's split";

@@ -11,8 +11,9 @@
 //! - The suite, on every N-th material: diffuse albedo x0.5 and a hue change (its channels
 //!   rotated), specular albedo x0.5, roughness x0.5 and x2, and the identity edit, for DeepBRDF
 //!   and IPCA (at the model's k), paper and residual edits and the residual edit carried onto
-//!   the table (transfer), and the two edits without a network, analytic
-//!   (`deepbrdf_eval::editing::analytic`) and stretch (`deepbrdf_eval::editing::stretch`): the
+//!   the table (transfer), and the edits without a network, analytic
+//!   (`deepbrdf_eval::editing::analytic`), stretch (`deepbrdf_eval::editing::stretch`) and, with
+//!   `--separation-data DIR`, stretch on Sun et al. 2018's split (`deepbrdf_eval::separation`): the
 //!   attributes re-estimated on each
 //!   decoded table against the requested ones (target error, change ratio, drift of the
 //!   untouched attributes), the identity edit's image RelAE against the original, the
@@ -22,18 +23,20 @@
 //!   re-estimated roughness along each Fig. 13/14 sweep.
 //!
 //! Writes `results.md` (the tables), `suite.csv` (every material and edit) and the figures.
-use super::editing_suite::{lobe_columns, lobe_summary, SuiteRow, SUITE_METHODS};
+use super::editing_suite::{lobe_columns, lobe_summary, SuiteRow, SEPARATED, SUITE_METHODS};
 use super::interpolate::{self, Path3};
 use crate::args::data::DataArgs;
 use crate::editing::{self, EditMode, EditorArg, ModelCodec, Space};
 use anyhow::Context;
+use deepbrdf_data::dataset::{DataSource, Dataset};
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::attributes::{Attributes, FitConfig};
 use deepbrdf_eval::editing::{
-    edit_outcome, is_monotone, judge_edit, plausibility, ColourEdit, Edit, EditOutcome, Lobe,
-    ScalarEdit,
+    edit_outcome, is_monotone, judge_edit, plausibility, stretch_edit, ColourEdit, Edit,
+    EditOutcome, Lobe, ScalarEdit,
 };
 use deepbrdf_eval::metrics::{ImageRelae, ImageRelaeConfig};
+use deepbrdf_eval::separation::{self, separated_attributes, SeparatedBasis, SeparationConfig};
 use deepbrdf_eval::stats::{finite_mean, finite_median};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -58,20 +61,24 @@ pub struct Args {
     /// Skip the figures (suite only).
     #[arg(long)]
     pub no_figures: bool,
+    /// Add the stretch edit on Sun et al. 2018's diffuse-specular split to the suite, the
+    /// separation fitted to the MERL .binary files of DIR (the training folder when the suite's
+    /// materials are held out).
+    #[arg(long, value_name = "DIR")]
+    pub separation_data: Option<PathBuf>,
     #[command(flatten)]
     pub data: DataArgs,
 }
 
+/// The suite's recolour: the diffuse channels rotated.
+const HUE: &str = "diffuse hue";
+
 /// The suite's edits: name and edit of a material's attributes.
 fn suite_edits(a: &Attributes) -> Vec<(&'static str, Edit)> {
-    let d = a.diffuse;
     vec![
         ("identity", Edit::default()),
         ("diffuse x0.5", Edit { diffuse: Some(ColourEdit::Scale(0.5)), ..Edit::default() }),
-        (
-            "diffuse hue",
-            Edit { diffuse: Some(ColourEdit::Set([d[2], d[0], d[1]])), ..Edit::default() },
-        ),
+        (HUE, Edit::rotated_diffuse(a.diffuse)),
         ("specular x0.5", Edit { specular: Some(ColourEdit::Scale(0.5)), ..Edit::default() }),
         ("roughness x0.5", Edit { roughness: Some(ScalarEdit::Scale(0.5)), ..Edit::default() }),
         ("roughness x2", Edit { roughness: Some(ScalarEdit::Scale(2.0)), ..Edit::default() }),
@@ -291,6 +298,19 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         }
     }
 
+    // The separation, when asked for.
+    let separation = match &args.separation_data {
+        Some(dir) => {
+            let source = DataSource::Folder(dir.clone());
+            let train = Dataset::load(&source, &args.data.cache(), progress)
+                .with_context(|| format!("loading the separation's data {}", source.label()))?;
+            let refs: Vec<&MerlTable> = train.tables.iter().collect();
+            let config = SeparationConfig::default();
+            Some(SeparatedBasis::fit(separation::NAME, &config, &refs, 1, progress)?)
+        }
+        None => None,
+    };
+
     // The suite.
     let chosen: Vec<usize> = (0..set.len()).step_by(args.every as usize).collect();
     let quick = editing::quick_fit();
@@ -360,11 +380,24 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                 }
             }
         }
+        let split = separation.as_ref().map(|b| separated_attributes(b, table, original));
         for (edit_name, edit) in suite_edits(original) {
             let Ok(requested) = edit.apply(original) else { continue };
             for mode in [EditMode::Analytic, EditMode::Stretch] {
                 let edited = mode.edit_without_network(table, original, &requested)?;
                 push(mode.name(), "-", edit_name, &edit, &requested, &edited)?;
+            }
+            // On the split, the recolour rotates the split's albedo; the outcome is judged
+            // against the request of the fit, as the other methods' are.
+            if let Some(split) = &split {
+                let asked = match edit_name {
+                    HUE => Edit::rotated_diffuse(split.diffuse),
+                    _ => edit,
+                };
+                if let Ok(on_split) = asked.apply(split) {
+                    let edited = stretch_edit(table, split, &on_split)?;
+                    push(SEPARATED, "-", edit_name, &edit, &requested, &edited)?;
+                }
             }
         }
         progress.advance(1);
@@ -399,7 +432,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         args.every,
         set.len()
     );
-    for method in ["DeepBRDF", "IPCA", "analytic", "stretch"] {
+    for method in ["DeepBRDF", "IPCA", "analytic", "stretch", SEPARATED] {
         for (edit_name, _) in suite_edits(&attrs[0]) {
             for (_, mode) in SUITE_METHODS.into_iter().filter(|(m, _)| *m == method) {
                 let sel: Vec<&SuiteRow> = rows
