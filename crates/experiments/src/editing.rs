@@ -45,12 +45,6 @@ pub fn mode_parser(
         .map(|s| s.parse().expect("a listed edit mode parses"))
 }
 
-/// The fit used to re-estimate the attributes of decoded tables in the measures: the
-/// library's, on a quarter of its cells (theta_d every 8th, phi_d every 16th).
-pub fn quick_fit() -> FitConfig {
-    FitConfig { theta_d_stride: 8, phi_d_stride: 16, ..FitConfig::default() }
-}
-
 /// The attributes of `table` (the library's fit).
 pub fn attributes_of(
     table: &MerlTable,

@@ -58,6 +58,12 @@ impl Default for FitConfig {
 }
 
 impl FitConfig {
+    /// The fit that re-estimates the attributes of edited and decoded tables in the editing
+    /// measures: the default on a quarter of its cells (theta_d every 8th, phi_d every 16th).
+    pub fn quick() -> Self {
+        Self { theta_d_stride: 8, phi_d_stride: 16, ..Self::default() }
+    }
+
     fn validate(&self) -> Result<()> {
         let bad = |what: &str| Err(EvalError::Invalid(format!("attribute fit: {what}")));
         if self.theta_d_stride == 0 || self.theta_d_stride > N_THETA_D {

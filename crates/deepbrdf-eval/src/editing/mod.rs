@@ -18,6 +18,7 @@ pub mod measures;
 pub mod request;
 pub mod space;
 pub mod stretch;
+pub mod suite;
 
 pub use analytic::{analytic_edit, carry_edit};
 pub use known::{KnownEdit, KnownTally};

@@ -6,9 +6,17 @@
 //! 2018, §4), which is the decomposition an edit of the diffuse part needs. The roughness edit
 //! then stretches only what lies above that floor, and an albedo edit moves only it.
 
-use super::SeparatedBasis;
+use super::{SeparatedBasis, SeparationConfig, NAME};
 use crate::attributes::Attributes;
-use deepbrdf_data::MerlTable;
+use crate::error::Result;
+use deepbrdf_data::{MerlTable, Progress};
+
+/// The separation fitted to `train` for splitting tables: the default settings; of the
+/// representation it also builds, one specular component is kept (a split needs only its
+/// search basis).
+pub fn fit_split(train: &[&MerlTable], progress: &dyn Progress) -> Result<SeparatedBasis> {
+    SeparatedBasis::fit(NAME, &SeparationConfig::default(), train, 1, progress)
+}
 
 /// The fitted attributes `fitted` of `table` with the diffuse albedo the separation finds
 /// (each channel in [0, 1], the range of an attribute): the attributes an edit on the split

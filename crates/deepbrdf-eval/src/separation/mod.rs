@@ -19,7 +19,7 @@ mod edit;
 mod search;
 
 pub use basis::SeparatedBasis;
-pub use edit::separated_attributes;
+pub use edit::{fit_split, separated_attributes};
 pub use search::{lowest_albedos, Sample, SearchBasis};
 
 use crate::baseline::{max_k, SharedEncoding};

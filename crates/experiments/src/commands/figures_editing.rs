@@ -23,7 +23,6 @@
 //!   re-estimated roughness along each Fig. 13/14 sweep.
 //!
 //! Writes `results.md` (the tables), `suite.csv` (every material and edit) and the figures.
-use super::editing_suite::{lobe_columns, lobe_summary, SuiteRow, SEPARATED, SUITE_METHODS};
 use super::interpolate::{self, Path3};
 use crate::args::data::DataArgs;
 use crate::editing::{self, EditMode, EditorArg, ModelCodec, Space};
@@ -31,15 +30,14 @@ use anyhow::Context;
 use deepbrdf_data::dataset::{DataSource, Dataset};
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::attributes::{Attributes, FitConfig};
-use deepbrdf_eval::editing::{
-    edit_outcome, is_monotone, judge_edit, plausibility, stretch_edit, ColourEdit, Edit,
-    EditOutcome, Lobe, ScalarEdit,
-};
+use deepbrdf_eval::baseline::BaselineCodec;
+use deepbrdf_eval::editing::suite::{self, report, Suite, SuiteInput, SuiteRepresentation as Rep};
+use deepbrdf_eval::editing::{is_monotone, ColourEdit, Edit, ScalarEdit};
 use deepbrdf_eval::metrics::{ImageRelae, ImageRelaeConfig};
-use deepbrdf_eval::separation::{self, separated_attributes, SeparatedBasis, SeparationConfig};
-use deepbrdf_eval::stats::{finite_mean, finite_median};
+use deepbrdf_eval::separation::{self, SeparatedBasis};
+use deepbrdf_model::DeepBrdf;
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 #[derive(Debug, clap::Args)]
@@ -70,29 +68,8 @@ pub struct Args {
     pub data: DataArgs,
 }
 
-/// The suite's recolour: the diffuse channels rotated.
-const HUE: &str = "diffuse hue";
-
-/// The suite's edits: name and edit of a material's attributes.
-fn suite_edits(a: &Attributes) -> Vec<(&'static str, Edit)> {
-    vec![
-        ("identity", Edit::default()),
-        ("diffuse x0.5", Edit { diffuse: Some(ColourEdit::Scale(0.5)), ..Edit::default() }),
-        (HUE, Edit::rotated_diffuse(a.diffuse)),
-        ("specular x0.5", Edit { specular: Some(ColourEdit::Scale(0.5)), ..Edit::default() }),
-        ("roughness x0.5", Edit { roughness: Some(ScalarEdit::Scale(0.5)), ..Edit::default() }),
-        ("roughness x2", Edit { roughness: Some(ScalarEdit::Scale(2.0)), ..Edit::default() }),
-    ]
-}
-
 /// The roughness scales of the Fig. 13/14 sweeps.
 const SWEEP: [f64; 7] = [0.25, 0.397, 0.63, 1.0, 1.587, 2.52, 4.0];
-
-/// A representation with its regressor, and the latent of each material under it.
-struct Rep<'a> {
-    name: &'static str,
-    space: Space<'a>,
-}
 
 /// A sweep of `edits` on one material for one representation and mode: its tables. The
 /// table is encoded only for a mode that edits its latent ([`EditMode::needs_latent`]).
@@ -110,72 +87,68 @@ fn sweep(
     edits.iter().map(|e| Ok(rep.space.edit(table, &latent, original, e, mode)?.table)).collect()
 }
 
-pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
-    let started = Instant::now();
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
-    let figure = args.figure.config()?;
-    let device = crate::args::device::device()?;
-    let (model_dir, model, deep_regressor) = args.editor.load(&device)?;
-    let k = model.k();
-    let set = args.data.load(progress)?;
-    let fit = FitConfig::default();
-    let attrs = editing::attributes_of_all(&set, &fit, progress)?;
-    // IPCA at the same k, with its regressor (saved by `train-regressor --ipca`, else trained
-    // here on the same materials).
-    let reg_dir = editing::regressor_dir(&model_dir, args.editor.regressor.as_deref());
-    let scratch = args.out.join("ipca-regressor");
-    let (ipca, ipca_regressor) =
-        editing::ipca_editor(&reg_dir, &set, &attrs, k, args.epochs, &scratch, progress, &device)?;
-    let deep_codec = ModelCodec(&model);
-    let deep =
-        Rep { name: "DeepBRDF", space: Space { codec: &deep_codec, regressor: &deep_regressor } };
-    let ipca_rep = Rep { name: "IPCA", space: Space { codec: &ipca, regressor: &ipca_regressor } };
-    let reps = [&deep, &ipca_rep];
-    let index = |name: &str| {
-        set.names
+/// What the figures are drawn from.
+struct Figures<'a> {
+    set: &'a Dataset,
+    attrs: &'a [Attributes],
+    fit: FitConfig,
+    figure: ImageRelaeConfig,
+    out: &'a Path,
+    model: &'a DeepBrdf,
+    ipca: &'a BaselineCodec,
+    deep: &'a Rep<'a>,
+    ipca_rep: &'a Rep<'a>,
+    progress: &'a dyn Progress,
+}
+
+impl Figures<'_> {
+    /// The index of material `name` in the set.
+    fn index(&self, name: &str) -> anyhow::Result<usize> {
+        self.set
+            .names
             .iter()
             .position(|n| n == name)
-            .with_context(|| format!("{name} is not in {}", set.label))
-    };
-    let seen = set.names.iter().filter(|n| model.provenance().trained_on(n)).count();
-    let scope = if seen == set.len() {
-        "in-sample: the autoencoder was trained on every one of them".to_string()
-    } else if seen == 0 {
-        "held out: none of them was in the autoencoder's training set".to_string()
-    } else {
-        format!("{seen} of them were in the autoencoder's training set")
-    };
-    let mut md = format!(
-        "# Editing (§5.1): figures and measured suite\n\nWritten by `experiments figures-editing` (model {}, k = {k}, {} materials of {}; {scope}; the regressors are those of `{}`, or trained here on these materials when missing).\n\n",
-        model.id(),
-        set.len(),
-        set.label,
-        crate::args::model::shown(&reg_dir)
-    );
+            .with_context(|| format!("{name} is not in {}", self.set.label))
+    }
 
-    let mut sweeps_md = String::new();
-    if !args.no_figures {
-        // Fig. 10.
-        let (a, b) = (index("red-metallic-paint")?, index("red-fabric")?);
-        let paths =
-            interpolate::paths(&model, Some(&ipca), &set.tables[a], &set.tables[b], 9, progress)?;
+    /// Figs. 10, 12, 13 and 14 and their sections of `md`; returns the table of re-estimated
+    /// roughness along the sweeps of Figs. 13 and 14.
+    fn draw(&self, md: &mut String) -> anyhow::Result<String> {
+        self.fig10(md)?;
+        self.fig12(md)?;
+        self.roughness_sweeps(md)
+    }
+
+    /// Fig. 10: red-metallic-paint to red-fabric in 9 steps, with its section of `md`.
+    fn fig10(&self, md: &mut String) -> anyhow::Result<()> {
+        let (a, b) = (self.index("red-metallic-paint")?, self.index("red-fabric")?);
+        let paths = interpolate::paths(
+            self.model,
+            Some(self.ipca),
+            &self.set.tables[a],
+            &self.set.tables[b],
+            9,
+            self.progress,
+        )?;
         let refs: Vec<&Path3> = paths.iter().collect();
         let (sheet, noise) = interpolate::strip(
             &refs,
             &|row, i| format!("{} t={:.3}", paths[row].name, i as f64 / 8.0),
-            &figure,
+            &self.figure,
         )?;
-        sheet.write_figure(&args.out.join("fig10_interpolation.jpg"))?;
+        sheet.write_figure(&self.out.join("fig10_interpolation.jpg"))?;
         let _ = write!(
             md,
             "## Fig. 10: red-metallic-paint to red-fabric, 9 steps\n\n![Fig. 10](fig10_interpolation.jpg)\n\n{}\n\nImage RelAE between consecutive steps (128 px sphere, sun and sky, 16 spp):\n\n",
-            interpolate::figure_caption(&figure, noise)
+            interpolate::figure_caption(&self.figure, noise)
         );
-        md += &interpolate::summary(&paths)?;
+        *md += &interpolate::summary(&paths)?;
+        Ok(())
+    }
 
-        // Fig. 12: diffuse colours of gray-plastic.
-        let g = index("gray-plastic")?;
+    /// Fig. 12: the diffuse albedo of gray-plastic set to several colours, with its section.
+    fn fig12(&self, md: &mut String) -> anyhow::Result<()> {
+        let g = self.index("gray-plastic")?;
         let colours: [(&str, [f64; 3]); 6] = [
             ("red", [0.5, 0.05, 0.05]),
             ("orange", [0.5, 0.25, 0.03]),
@@ -188,11 +161,11 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             .iter()
             .map(|(_, c)| Edit { diffuse: Some(ColourEdit::Set(*c)), ..Edit::default() })
             .collect();
-        let reference = ImageRelae::new(&set.tables[g], &ImageRelaeConfig::default())?;
+        let reference = ImageRelae::new(&self.set.tables[g], &ImageRelaeConfig::default())?;
         let mut rows = Vec::new();
         for mode in [EditMode::Paper, EditMode::Residual, EditMode::Stretch] {
-            let mut tables = vec![set.tables[g].clone()];
-            tables.extend(sweep(&deep, &set.tables[g], &attrs[g], &edits, mode)?);
+            let mut tables = vec![self.set.tables[g].clone()];
+            tables.extend(sweep(self.deep, &self.set.tables[g], &self.attrs[g], &edits, mode)?);
             let images = interpolate::render_all(&reference, &tables)?;
             let name = match mode.needs_network() {
                 true => format!("DeepBRDF {}", mode.name()),
@@ -205,18 +178,18 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             0 => "original".into(),
             _ => format!("{} {}", rows[row].name.trim_start_matches("DeepBRDF "), colours[i - 1].0),
         };
-        let (sheet, noise) = interpolate::strip(&refs, &captions, &figure)?;
-        sheet.write_figure(&args.out.join("fig12_diffuse.jpg"))?;
+        let (sheet, noise) = interpolate::strip(&refs, &captions, &self.figure)?;
+        sheet.write_figure(&self.out.join("fig12_diffuse.jpg"))?;
         let _ = write!(
             md,
             "\n## Fig. 12: diffuse albedo of gray-plastic\n\n![Fig. 12](fig12_diffuse.jpg)\n\n{}\n\nRows: the paper's edit, the residual edit (DeepBRDF), the stretch edit (no network: the diffuse albedo as the analytic edit sets it); first column the measurement. Requested vs re-estimated diffuse albedo:\n\n| edit | requested | paper: achieved | residual: achieved | stretch: achieved |\n| --- | --- | --- | --- | --- |\n",
-            interpolate::figure_caption(&figure, noise)
+            interpolate::figure_caption(&self.figure, noise)
         );
         for (i, (name, c)) in colours.iter().enumerate() {
             let got: Vec<String> = rows
                 .iter()
                 .map(|r| {
-                    let a = editing::attributes_of(&r.tables[i + 1], name, &fit)?;
+                    let a = editing::attributes_of(&r.tables[i + 1], name, &self.fit)?;
                     anyhow::Ok(format!(
                         "{:.3} {:.3} {:.3}",
                         a.diffuse[0], a.diffuse[1], a.diffuse[2]
@@ -229,19 +202,24 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                 c[0], c[1], c[2], got[0], got[1], got[2]
             );
         }
+        Ok(())
+    }
 
-        // Figs. 13 and 14: roughness sweeps.
+    /// Figs. 13 and 14: roughness sweeps, their sections in `md` and the table of re-estimated
+    /// roughness along each sweep, returned.
+    fn roughness_sweeps(&self, md: &mut String) -> anyhow::Result<String> {
+        let mut sweeps_md = String::new();
         let sweep_edits: Vec<Edit> = SWEEP
             .iter()
             .map(|s| Edit { roughness: Some(ScalarEdit::Scale(*s)), ..Edit::default() })
             .collect();
         sweeps_md += "\n## Roughness sweeps (Figs. 13, 14): re-estimated roughness along x1/4 ... x4\n\n| material | representation | edit | requested | re-estimated | monotone |\n| --- | --- | --- | --- | --- | --- |\n";
         for (fig, material, methods) in [
-            ("fig13_roughness", "red-plastic", vec![&deep]),
-            ("fig14_roughness", "specular-yellow-phenolic", vec![&deep, &ipca_rep]),
+            ("fig13_roughness", "red-plastic", vec![self.deep]),
+            ("fig14_roughness", "specular-yellow-phenolic", vec![self.deep, self.ipca_rep]),
         ] {
-            let m = index(material)?;
-            let a = &attrs[m];
+            let m = self.index(material)?;
+            let a = &self.attrs[m];
             let usable: Vec<(f64, Edit)> = SWEEP
                 .iter()
                 .copied()
@@ -249,20 +227,20 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                 .filter(|(_, e)| e.apply(a).is_ok())
                 .collect();
             let edits: Vec<Edit> = usable.iter().map(|(_, e)| *e).collect();
-            let reference = ImageRelae::new(&set.tables[m], &ImageRelaeConfig::default())?;
+            let reference = ImageRelae::new(&self.set.tables[m], &ImageRelaeConfig::default())?;
             let mut rows = Vec::new();
             // Each representation's paper and residual edits, then the stretch edit (no
             // network) once.
             let runs = methods
                 .iter()
                 .flat_map(|rep| [(*rep, EditMode::Paper), (*rep, EditMode::Residual)])
-                .chain([(&deep, EditMode::Stretch)]);
+                .chain([(self.deep, EditMode::Stretch)]);
             for (rep, mode) in runs {
                 let rep_name = if mode.needs_network() { rep.name } else { "-" };
-                let tables = sweep(rep, &set.tables[m], a, &edits, mode)?;
+                let tables = sweep(rep, &self.set.tables[m], a, &edits, mode)?;
                 let got: Vec<f64> = tables
                     .iter()
-                    .map(|t| Ok(editing::attributes_of(t, material, &fit)?.roughness))
+                    .map(|t| Ok(editing::attributes_of(t, material, &self.fit)?.roughness))
                     .collect::<anyhow::Result<_>>()?;
                 let requested: Vec<String> =
                     usable.iter().map(|(s, _)| format!("{:.3}", a.roughness * s)).collect();
@@ -285,203 +263,131 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             }
             let refs: Vec<&Path3> = rows.iter().collect();
             let captions = |row: usize, i: usize| format!("{} x{:.2}", rows[row].name, usable[i].0);
-            let (sheet, noise) = interpolate::strip(&refs, &captions, &figure)?;
-            sheet.write_figure(&args.out.join(format!("{fig}.jpg")))?;
+            let (sheet, noise) = interpolate::strip(&refs, &captions, &self.figure)?;
+            sheet.write_figure(&self.out.join(format!("{fig}.jpg")))?;
             let _ = write!(
                 md,
                 "\n## {}: roughness of {material}\n\n![{fig}]({fig}.jpg)\n\n{}\n\nRows: {}; columns: roughness x{}.\n",
                 if fig.starts_with("fig13") { "Fig. 13" } else { "Fig. 14" },
-                interpolate::figure_caption(&figure, noise),
+                interpolate::figure_caption(&self.figure, noise),
                 rows.iter().map(|r| r.name.as_str()).collect::<Vec<_>>().join(", "),
                 usable.iter().map(|(s, _)| format!("{s:.2}")).collect::<Vec<_>>().join(", x")
             );
         }
+        Ok(sweeps_md)
     }
+}
 
-    // The separation, when asked for.
+pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
+    let started = Instant::now();
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let figure = args.figure.config()?;
+    let device = crate::args::device::device()?;
+    let (model_dir, model, deep_regressor) = args.editor.load(&device)?;
+    let k = model.k();
+    let set = args.data.load(progress)?;
+    let fit = FitConfig::default();
+    let attrs = editing::attributes_of_all(&set, &fit, progress)?;
+    // IPCA at the same k, with its regressor (saved by `train-regressor --ipca`, else trained
+    // here on the same materials).
+    let reg_dir = editing::regressor_dir(&model_dir, args.editor.regressor.as_deref());
+    let scratch = args.out.join("ipca-regressor");
+    let (ipca, ipca_regressor) =
+        editing::ipca_editor(&reg_dir, &set, &attrs, k, args.epochs, &scratch, progress, &device)?;
+    let deep_codec = ModelCodec(&model);
+    let reps = [
+        Rep { name: "DeepBRDF", space: Space { codec: &deep_codec, regressor: &deep_regressor } },
+        Rep { name: "IPCA", space: Space { codec: &ipca, regressor: &ipca_regressor } },
+    ];
+    let mut md = header(&model, &set, &crate::args::model::shown(&reg_dir));
+    let mut sweeps_md = String::new();
+    if !args.no_figures {
+        let figures = Figures {
+            set: &set,
+            attrs: &attrs,
+            fit,
+            figure,
+            out: &args.out,
+            model: &model,
+            ipca: &ipca,
+            deep: &reps[0],
+            ipca_rep: &reps[1],
+            progress,
+        };
+        sweeps_md = figures.draw(&mut md)?;
+    }
     let separation = match &args.separation_data {
-        Some(dir) => {
-            let source = DataSource::Folder(dir.clone());
-            let train = Dataset::load(&source, &args.data.cache(), progress)
-                .with_context(|| format!("loading the separation's data {}", source.label()))?;
-            let refs: Vec<&MerlTable> = train.tables.iter().collect();
-            let config = SeparationConfig::default();
-            Some(SeparatedBasis::fit(separation::NAME, &config, &refs, 1, progress)?)
-        }
+        Some(dir) => Some(fit_separation(dir, &args.data, progress)?),
         None => None,
     };
-
-    // The suite.
-    let chosen: Vec<usize> = (0..set.len()).step_by(args.every as usize).collect();
-    let quick = editing::quick_fit();
-    let mut rows: Vec<SuiteRow> = Vec::new();
-    let mut lobe_skipped: Vec<String> = Vec::new();
-    progress.start(chosen.len() as u64, "edit suite");
-    for &m in &chosen {
-        let (name, table, original) = (&set.names[m], &set.tables[m], &attrs[m]);
-        let reference = ImageRelae::new(table, &ImageRelaeConfig::default())?;
-        let original_lobe = match Lobe::of(table) {
-            Ok(l) => Some(l),
-            Err(e) => {
-                lobe_skipped.push(format!("{name}: {e}"));
-                None
-            }
-        };
-        let mut push = |method: &'static str,
-                        mode: &'static str,
-                        edit_name: &'static str,
-                        edit: &Edit,
-                        requested: &Attributes,
-                        edited: &MerlTable|
-         -> anyhow::Result<()> {
-            let achieved = editing::attributes_of(edited, name, &quick)?;
-            let outcome = edit_outcome(original, requested, &achieved, edit.edited());
-            let identity_relae = match edit_name {
-                "identity" => reference.measure(edited)?,
-                _ => f64::NAN,
-            };
-            let p = plausibility(edited);
-            let lobe = match original_lobe.as_ref().map(|o| judge_edit(o, edited, edit)) {
-                Some(Ok(l)) => Some(l),
-                Some(Err(e)) => {
-                    lobe_skipped.push(format!("{name}, {method} {mode} {edit_name}: {e}"));
-                    None
-                }
-                None => None,
-            };
-            rows.push(SuiteRow {
-                material: name.clone(),
-                method,
-                mode,
-                edit: edit_name,
-                outcome,
-                identity_relae,
-                plausible: p.is_plausible(),
-                max_albedo: p.max_albedo,
-                lobe,
-            });
-            Ok(())
-        };
-        for rep in reps {
-            let latent = rep.space.codec.encode(table)?;
-            for mode in [EditMode::Paper, EditMode::Residual, EditMode::Transfer] {
-                for (edit_name, edit) in suite_edits(original) {
-                    let Ok(edited) = rep.space.edit(table, &latent, original, &edit, mode) else {
-                        continue; // an edit out of range for this material (e.g. x2 past alpha 1)
-                    };
-                    push(
-                        rep.name,
-                        mode.name(),
-                        edit_name,
-                        &edit,
-                        &edited.requested,
-                        &edited.table,
-                    )?;
-                }
-            }
-        }
-        let split = separation.as_ref().map(|b| separated_attributes(b, table, original));
-        for (edit_name, edit) in suite_edits(original) {
-            let Ok(requested) = edit.apply(original) else { continue };
-            for mode in [EditMode::Analytic, EditMode::Stretch] {
-                let edited = mode.edit_without_network(table, original, &requested)?;
-                push(mode.name(), "-", edit_name, &edit, &requested, &edited)?;
-            }
-            // On the split, the recolour rotates the split's albedo; the outcome is judged
-            // against the request of the fit, as the other methods' are.
-            if let Some(split) = &split {
-                let asked = match edit_name {
-                    HUE => Edit::rotated_diffuse(split.diffuse),
-                    _ => edit,
-                };
-                if let Ok(on_split) = asked.apply(split) {
-                    let edited = stretch_edit(table, split, &on_split)?;
-                    push(SEPARATED, "-", edit_name, &edit, &requested, &edited)?;
-                }
-            }
-        }
-        progress.advance(1);
-    }
-    progress.finish();
-    let mut csv = String::from("material,method,mode,edit,target_error,change_ratio,diffuse_drift,specular_drift,roughness_drift,identity_relae,plausible,max_albedo,floor_ratio,peak_ratio,hwhm_ratio,dark_hole,lobe_bar,meets_bar,lobe_pass\n");
-    for r in &rows {
-        let o = r.outcome;
-        let _ = writeln!(
-            csv,
-            "{},{},{},{},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{},{:.6},{}",
-            r.material,
-            r.method,
-            r.mode,
-            r.edit,
-            o.target_error,
-            o.change_ratio,
-            o.diffuse_drift,
-            o.specular_drift,
-            o.roughness_drift,
-            r.identity_relae,
-            r.plausible,
-            r.max_albedo,
-            lobe_columns(r.lobe.as_ref())
-        );
-    }
-    deepbrdf_data::files::write_atomic(&args.out.join("suite.csv"), csv.as_bytes())?;
-    let _ = write!(
-        md,
-        "\n## Edit suite ({} materials: every {}-th of {}; attributes re-estimated with the fit on a quarter of its cells)\n\nMedians over the materials (means in `suite.csv`' rows): target error `|achieved - requested| / |requested|` of the edited attribute, change ratio (achieved change over requested change, 1 = as asked), relative drift of the untouched attributes, share of materials whose edit is within 10% of the target with less than 10% drift of every other attribute; identity edit: image RelAE against the measurement; plausible: no negative value and directional albedo <= 1 at 0-85 degrees.\n\n| representation | edit | mode | target error | change ratio | diffuse drift | specular drift | roughness drift | within 10% / drift < 10% | identity image RelAE | plausible |\n| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n",
-        chosen.len(),
-        args.every,
-        set.len()
-    );
-    for method in ["DeepBRDF", "IPCA", "analytic", "stretch", SEPARATED] {
-        for (edit_name, _) in suite_edits(&attrs[0]) {
-            for (_, mode) in SUITE_METHODS.into_iter().filter(|(m, _)| *m == method) {
-                let sel: Vec<&SuiteRow> = rows
-                    .iter()
-                    .filter(|r| r.method == method && r.edit == edit_name && r.mode == mode)
-                    .collect();
-                if sel.is_empty() {
-                    continue;
-                }
-                let f =
-                    |g: fn(&EditOutcome) -> f64| finite_median(sel.iter().map(|r| g(&r.outcome)));
-                let good = sel
-                    .iter()
-                    .filter(|r| {
-                        let o = r.outcome;
-                        let drifts = [o.diffuse_drift, o.specular_drift, o.roughness_drift];
-                        let target_ok = o.target_error.is_nan() || o.target_error < 0.1;
-                        target_ok && drifts.iter().all(|d| d.is_nan() || *d < 0.1)
-                    })
-                    .count();
-                let plausible = sel.iter().filter(|r| r.plausible).count();
-                let show = |v: f64| if v.is_finite() { format!("{v:.3}") } else { "-".into() };
-                let _ = writeln!(
-                    md,
-                    "| {method} | {edit_name} | {mode} | {} | {} | {} | {} | {} | {good}/{} | {} | {plausible}/{} |",
-                    show(f(|o| o.target_error)),
-                    show(f(|o| o.change_ratio)),
-                    show(f(|o| o.diffuse_drift)),
-                    show(f(|o| o.specular_drift)),
-                    show(f(|o| o.roughness_drift)),
-                    sel.len(),
-                    show(finite_mean(sel.iter().map(|r| r.identity_relae))),
-                    sel.len()
-                );
-            }
-        }
-    }
-    let _ = write!(
-        md,
-        "\n### The specular lobe as a person sees it\n\nRead off each decoded table against the measurement: the luminance over theta_h (theta_d < 15 deg, all phi_d), the diffuse floor (its median for theta_h >= 45 deg), the lobe above it, its peak and half width at half maximum; a dark hole is the lobe at theta_h ~ 0 below 60% of its maximum within 15 deg where the measurement's was not. Per edit in `suite.csv` (`floor_ratio`, `peak_ratio`, `hwhm_ratio`, `dark_hole`, `lobe_bar`, `meets_bar`, `lobe_pass`). Dark holes are counted over every edit, identity included.\n\n{}",
-        lobe_summary(&rows)
-    );
-    for skipped in &lobe_skipped {
-        let _ = writeln!(md, "\nLobe not measured: {skipped}.");
-    }
+    let input = SuiteInput {
+        names: &set.names,
+        tables: &set.tables,
+        attributes: &attrs,
+        every: args.every as usize,
+        representations: &reps,
+        separation: separation.as_ref(),
+    };
+    let suite = suite::run(&input, progress)?;
+    deepbrdf_data::files::write_atomic(
+        &args.out.join("suite.csv"),
+        report::csv(&suite.rows).as_bytes(),
+    )?;
+    md += &suite_sections(&suite, args.every, set.len());
     md += &sweeps_md;
     let _ = write!(md, "\nWhole command {:.0} s.\n", started.elapsed().as_secs_f64());
     deepbrdf_data::files::write_atomic(&args.out.join("results.md"), md.as_bytes())?;
     println!("{md}");
     println!("wrote {}", args.out.display());
     Ok(())
+}
+
+/// The results' title and provenance: the model, the materials and whether it saw them.
+fn header(model: &DeepBrdf, set: &Dataset, regressors: &str) -> String {
+    let seen = set.names.iter().filter(|n| model.provenance().trained_on(n)).count();
+    let scope = if seen == set.len() {
+        "in-sample: the autoencoder was trained on every one of them".to_string()
+    } else if seen == 0 {
+        "held out: none of them was in the autoencoder's training set".to_string()
+    } else {
+        format!("{seen} of them were in the autoencoder's training set")
+    };
+    format!(
+        "# Editing (§5.1): figures and measured suite\n\nWritten by `experiments figures-editing` (model {}, k = {}, {} materials of {}; {scope}; the regressors are those of `{regressors}`, or trained here on these materials when missing).\n\n",
+        model.id(),
+        model.k(),
+        set.len(),
+        set.label,
+    )
+}
+
+/// Sun et al. 2018's split fitted to the MERL files of `dir`.
+fn fit_separation(
+    dir: &Path,
+    data: &DataArgs,
+    progress: &dyn Progress,
+) -> anyhow::Result<SeparatedBasis> {
+    let source = DataSource::Folder(dir.to_path_buf());
+    let train = Dataset::load(&source, &data.cache(), progress)
+        .with_context(|| format!("loading the separation's data {}", source.label()))?;
+    Ok(separation::fit_split(&train.tables.iter().collect::<Vec<_>>(), progress)?)
+}
+
+/// The suite's sections of the results: the re-estimated attributes and the lobe tables.
+fn suite_sections(suite: &Suite, every: u32, of: usize) -> String {
+    let mut md = format!(
+        "\n## Edit suite ({} materials: every {every}-th of {of}; attributes re-estimated with the fit on a quarter of its cells)\n\nMedians over the materials (means in `suite.csv`' rows): target error `|achieved - requested| / |requested|` of the edited attribute, change ratio (achieved change over requested change, 1 = as asked), relative drift of the untouched attributes, share of materials whose edit is within 10% of the target with less than 10% drift of every other attribute; identity edit: image RelAE against the measurement; plausible: no negative value and directional albedo <= 1 at 0-85 degrees.\n\n| representation | edit | mode | target error | change ratio | diffuse drift | specular drift | roughness drift | within 10% / drift < 10% | identity image RelAE | plausible |\n| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n{}",
+        suite.materials,
+        report::outcome_summary(&suite.rows)
+    );
+    let _ = write!(
+        md,
+        "\n### The specular lobe as a person sees it\n\nRead off each decoded table against the measurement: the luminance over theta_h (theta_d < 15 deg, all phi_d), the diffuse floor (its median for theta_h >= 45 deg), the lobe above it, its peak and half width at half maximum; a dark hole is the lobe at theta_h ~ 0 below 60% of its maximum within 15 deg where the measurement's was not. Per edit in `suite.csv` (`floor_ratio`, `peak_ratio`, `hwhm_ratio`, `dark_hole`, `lobe_bar`, `meets_bar`, `lobe_pass`). Dark holes are counted over every edit, identity included.\n\n{}",
+        report::lobe_summary(&suite.rows)
+    );
+    for skipped in &suite.lobe_skipped {
+        let _ = writeln!(md, "\nLobe not measured: {skipped}.");
+    }
+    md
 }

@@ -13,7 +13,6 @@ pub mod decode;
 pub mod devices;
 pub mod edit;
 pub mod edit_known;
-pub mod editing_suite;
 pub mod encode;
 pub mod export_bsdf;
 pub mod fetch_merl;

@@ -389,7 +389,7 @@ impl Editor {
                 }
                 self.current(generation)?;
                 let achieved =
-                    editing::attributes_of(&table, "the edited table", &editing::quick_fit())?;
+                    editing::attributes_of(&table, "the edited table", &FitConfig::quick())?;
                 (Image::mean(&images).map_err(internal)?, REFINED, Some((&achieved).into()))
             }
         };

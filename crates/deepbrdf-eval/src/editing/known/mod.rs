@@ -6,6 +6,8 @@
 //! Distances are image RelAE against the answer's render ([`ImageRelae`]: the answer rendered
 //! once, every candidate with the same random numbers).
 
+pub mod suite;
+
 use crate::error::{EvalError, Result};
 use crate::metrics::{ImageRelae, ImageRelaeConfig};
 use crate::stats::finite_median;
