@@ -3,12 +3,16 @@
 //! [`slices`]), and Fig. 5's latent plane ([`latent_plane`]) drawn as a scatter plot of
 //! materials ([`scatter`]).
 pub mod compact;
+pub mod latent_map;
 pub mod latent_plane;
 mod plots;
+pub mod reconstruction_sheet;
 pub mod scatter;
 pub mod slices;
 
 pub use compact::compact_svg;
+pub use latent_map::{LatentMap, LatentMapInput};
 pub use latent_plane::LatentPlane;
 pub use plots::{write_chart, write_panels, LineChart, Series};
+pub use reconstruction_sheet::{ReconstructionSheet, SheetInput};
 pub use scatter::{draw_scatter, ScatterPlot, ScatterPoint};

@@ -18,15 +18,14 @@ use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::dataset::{DataSource, Dataset};
 use deepbrdf_data::files::write_atomic;
-use deepbrdf_data::Progress;
+use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::baseline::BaselineMethod;
+use deepbrdf_eval::figures::{ReconstructionSheet, SheetInput};
 use deepbrdf_eval::harness::{Codec, Method};
-use deepbrdf_eval::metrics::{relae, ImageRelae};
+use deepbrdf_eval::metrics::ImageRelaeConfig;
 use deepbrdf_eval::separation::SeparatedMethod;
 use deepbrdf_eval::stats::finite_mean;
 use deepbrdf_model::DeepBrdf;
-use deepbrdf_render::sheet::{contact_sheet, SheetConfig, Tile};
-use deepbrdf_render::Tonemap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
@@ -118,6 +117,131 @@ fn model_collections(
     Ok(train)
 }
 
+/// The materials to show: the collection or folder, or the ones `--materials` names.
+fn shown_materials(
+    args: &Args,
+    cache: &deepbrdf_data::cache::Cache,
+    progress: &dyn Progress,
+) -> anyhow::Result<Dataset> {
+    let source = match &args.data {
+        Some(dir) => DataSource::Folder(dir.clone()),
+        None => DataSource::Bundled(args.collection),
+    };
+    let shown = Dataset::load(&source, cache, progress)
+        .with_context(|| format!("loading the dataset {}", source.label()))?;
+    let Some(names) = &args.materials else { return Ok(shown) };
+    let mut picked = Dataset { label: shown.label.clone(), names: vec![], tables: vec![] };
+    for name in names {
+        let table = shown.get(name).with_context(|| {
+            format!("--materials: '{name}' is not in {} ({} materials)", shown.label, shown.len())
+        })?;
+        picked.names.push(name.clone());
+        picked.tables.push(table.clone());
+    }
+    Ok(picked)
+}
+
+/// A note where shown materials are in the representations' training data (a model trained
+/// with `--add-collections` names them `COLLECTION/NAME`): then the figure is in-sample.
+fn in_sample_note(args: &Args, train: &Dataset, shown: &Dataset) -> Option<String> {
+    let seen = shown
+        .names
+        .iter()
+        .filter(|n| {
+            train.names.contains(n)
+                || (args.data.is_none()
+                    && train.names.contains(&format!("{}/{n}", args.collection.name())))
+        })
+        .count();
+    (seen > 0).then(|| match args.baseline {
+        Baseline::Ipca => format!(
+            "{seen} of the {} shown materials are in the training data of both representations: \
+             in-sample, not Fig. 9's generalization (give --model with a model trained on merl \
+             alone)",
+            shown.len()
+        ),
+        Baseline::Sun2018 => format!(
+            "{seen} of the {} shown materials are in the training data of both representations: \
+             in-sample, as the paper's Fig. 8",
+            shown.len()
+        ),
+    })
+}
+
+/// The figure's words: its number, the baseline's label and CSV column, the image's file name
+/// and the in-sample note, if any.
+struct Text<'a> {
+    figure: u32,
+    label: &'a str,
+    column: &'a str,
+    image: &'a str,
+    in_sample: Option<&'a str>,
+}
+
+impl Text<'_> {
+    /// The figure's CSV and summary.
+    fn write(
+        &self,
+        model: &DeepBrdf,
+        train: &Dataset,
+        shown: &Dataset,
+        sheet: &ReconstructionSheet,
+        config: &ImageRelaeConfig,
+    ) -> anyhow::Result<(String, String)> {
+        let Text { figure, label, column, image, in_sample } = *self;
+        let k = model.k();
+        let rows: Vec<Row> = (0..shown.len())
+            .map(|s| Row {
+                material: shown.names[s].clone(),
+                noise: sheet.noise[s],
+                deepbrdf: sheet.columns[0].relae[s],
+                baseline: sheet.columns[1].relae[s],
+            })
+            .collect();
+        let max_noise = rows.iter().map(|r| r.noise).fold(0.0, f64::max);
+        let mut csv = format!("material,render_noise,relae_deepbrdf,{column}\n");
+        let mut md = format!(
+            "Fig. {figure} on {} ({} materials), written by `experiments figures-generalize`: \
+             DeepBRDF model {} (k = {k}, trained on {}) and {label} at k = {k} fitted on {} ({} \
+             materials); rows: as measured, DeepBRDF, {label}; image RelAE on the preview sphere \
+             under sun and sky \
+             ({size} px, {spp} spp, Sobol points, seed {seed}). Render noise: the image RelAE \
+             between two renders of the measurement with seeds {seed} and {seed2}, at most \
+             {max_noise:.4}; each reconstruction's render shares its random numbers with the \
+             measurement's, so its noise is below that.\n\n\
+             ![Fig. {figure}]({image})\n\n| material | render noise | DeepBRDF | {label} |\n\
+             | --- | ---: | ---: | ---: |\n",
+            shown.label,
+            shown.len(),
+            model.id(),
+            model.provenance().data_label,
+            train.label,
+            train.len(),
+            size = config.render.size,
+            spp = config.render.spp,
+            seed = config.render.seed,
+            seed2 = config.next_seed().render.seed,
+        );
+        for r in &rows {
+            writeln!(csv, "{},{:.6},{:.6},{:.6}", r.material, r.noise, r.deepbrdf, r.baseline)?;
+            writeln!(
+                md,
+                "| {} | {:.4} | {:.4} | {:.4} |",
+                r.material, r.noise, r.deepbrdf, r.baseline
+            )?;
+        }
+        let d = finite_mean(rows.iter().map(|r| r.deepbrdf));
+        let b = finite_mean(rows.iter().map(|r| r.baseline));
+        let wins = rows.iter().filter(|r| r.deepbrdf < r.baseline).count();
+        writeln!(md, "| **mean** | | **{d:.4}** | **{b:.4}** |")?;
+        writeln!(md, "\nDeepBRDF is below {label} on {wins} of {} materials.", rows.len())?;
+        if let Some(note) = in_sample {
+            writeln!(md, "\n**Note**: {note}.")?;
+        }
+        Ok((csv, md))
+    }
+}
+
 /// One material's row.
 struct Row {
     material: String,
@@ -144,129 +268,33 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let (figure, label, column) = args.baseline.figure();
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("results/fig{figure}")));
     let deep = ModelCodec(&model);
-    let source = match &args.data {
-        Some(dir) => DataSource::Folder(dir.clone()),
-        None => DataSource::Bundled(args.collection),
-    };
-    let mut shown = Dataset::load(&source, &cache, progress)
-        .with_context(|| format!("loading the dataset {}", source.label()))?;
-    if let Some(names) = &args.materials {
-        let mut picked = Dataset { label: shown.label.clone(), names: vec![], tables: vec![] };
-        for name in names {
-            let table = shown.get(name).with_context(|| {
-                format!(
-                    "--materials: '{name}' is not in {} ({} materials)",
-                    shown.label,
-                    shown.len()
-                )
-            })?;
-            picked.names.push(name.clone());
-            picked.tables.push(table.clone());
-        }
-        shown = picked;
-    }
+    let shown = shown_materials(&args, &cache, progress)?;
     // Fitted once the materials to show are known (a wrong name costs no fit).
     let baseline = args.baseline.fit(&train, k, progress)?;
-    // Shown materials the representations were fitted to (a model trained with
-    // `--add-collections` names them `COLLECTION/NAME`): then the figure is in-sample.
-    let seen = shown
-        .names
-        .iter()
-        .filter(|n| {
-            train.names.contains(n)
-                || (args.data.is_none()
-                    && train.names.contains(&format!("{}/{n}", args.collection.name())))
-        })
-        .count();
-    let in_sample = (seen > 0).then(|| match args.baseline {
-        Baseline::Ipca => format!(
-            "{seen} of the {} shown materials are in the training data of both representations: \
-             in-sample, not Fig. 9's generalization (give --model with a model trained on merl \
-             alone)",
-            shown.len()
-        ),
-        Baseline::Sun2018 => format!(
-            "{seen} of the {} shown materials are in the training data of both representations: \
-             in-sample, as the paper's Fig. 8",
-            shown.len()
-        ),
-    });
+    let in_sample = in_sample_note(&args, &train, &shown);
     if let Some(note) = &in_sample {
         eprintln!("note: {note}");
     }
 
-    let tonemap = Tonemap::default();
-    let srgb = |img: &deepbrdf_render::Image| img.to_srgb8(&tonemap, [0, 0, 0]);
-    let (mut originals, mut deeps, mut bases, mut rows) = (vec![], vec![], vec![], vec![]);
-    progress.start(4 * shown.len() as u64, &format!("rendering Fig. {figure}"));
-    for (name, table) in shown.names.iter().zip(&shown.tables) {
-        let measure = ImageRelae::new(table, &config)?;
-        progress.advance(1);
-        let noise = measure.noise(table)?;
-        progress.advance(1);
-        let short = name.rsplit('/').next().unwrap_or(name).to_string();
-        let mut row = Row { material: name.clone(), noise, deepbrdf: 0.0, baseline: 0.0 };
-        for (label, codec, slot, out) in [
-            ("DeepBRDF", &deep as &dyn Codec, &mut row.deepbrdf, &mut deeps),
-            (label, baseline.as_ref(), &mut row.baseline, &mut bases),
-        ] {
-            let reconstruction = codec.decode(&codec.encode(table)?)?;
-            let image = measure.render(&reconstruction)?;
-            *slot = relae(&image, measure.reference())?;
-            out.push(Tile { image: srgb(&image), caption: format!("{label}: RelAE {:.3}", *slot) });
-            progress.advance(1);
-        }
-        originals.push(Tile { image: srgb(measure.reference()), caption: short });
-        rows.push(row);
-    }
-    progress.finish();
-    let columns = rows.len() as u32;
-    let tiles: Vec<Tile> = originals.into_iter().chain(deeps).chain(bases).collect();
+    let names: Vec<&str> = shown.names.iter().map(|n| n.rsplit('/').next().unwrap_or(n)).collect();
+    let tables: Vec<&MerlTable> = shown.tables.iter().collect();
+    let methods: [(&str, &dyn Codec); 2] = [("DeepBRDF", &deep), (label, baseline.as_ref())];
+    let caption = |label: &str, _k: usize, e: f64| format!("{label}: RelAE {e:.3}");
+    let input = SheetInput {
+        names: &names,
+        tables: &tables,
+        methods: &methods,
+        config: &config,
+        background: [0, 0, 0],
+        caption: &caption,
+    };
+    let sheet =
+        ReconstructionSheet::measure(&input, progress).with_context(|| format!("Fig. {figure}"))?;
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
-    let sheet = SheetConfig { columns, caption_height: 22, font_px: 15, ..Default::default() };
     let image = format!("fig{figure}.jpg");
-    contact_sheet(&tiles, &sheet)?.write_figure(&out.join(&image))?;
-
-    let max_noise = rows.iter().map(|r| r.noise).fold(0.0, f64::max);
-    let mut csv = format!("material,render_noise,relae_deepbrdf,{column}\n");
-    let mut md = format!(
-        "Fig. {figure} on {} ({} materials), written by `experiments figures-generalize`: \
-         DeepBRDF model {} (k = {k}, trained on {}) and {label} at k = {k} fitted on {} ({} \
-         materials); rows: as measured, DeepBRDF, {label}; image RelAE on the preview sphere \
-         under sun and sky \
-         ({size} px, {spp} spp, Sobol points, seed {seed}). Render noise: the image RelAE \
-         between two renders of the measurement with seeds {seed} and {seed2}, at most \
-         {max_noise:.4}; each reconstruction's render shares its random numbers with the \
-         measurement's, so its noise is below that.\n\n\
-         ![Fig. {figure}]({image})\n\n| material | render noise | DeepBRDF | {label} |\n\
-         | --- | ---: | ---: | ---: |\n",
-        shown.label,
-        shown.len(),
-        model.id(),
-        model.provenance().data_label,
-        train.label,
-        train.len(),
-        size = config.render.size,
-        spp = config.render.spp,
-        seed = config.render.seed,
-        seed2 = config.next_seed().render.seed,
-    );
-    for r in &rows {
-        writeln!(csv, "{},{:.6},{:.6},{:.6}", r.material, r.noise, r.deepbrdf, r.baseline)?;
-        writeln!(
-            md,
-            "| {} | {:.4} | {:.4} | {:.4} |",
-            r.material, r.noise, r.deepbrdf, r.baseline
-        )?;
-    }
-    let d = finite_mean(rows.iter().map(|r| r.deepbrdf));
-    let b = finite_mean(rows.iter().map(|r| r.baseline));
-    let wins = rows.iter().filter(|r| r.deepbrdf < r.baseline).count();
-    writeln!(md, "| **mean** | | **{d:.4}** | **{b:.4}** |")?;
-    writeln!(md, "\nDeepBRDF is below {label} on {wins} of {} materials.", rows.len())?;
-    if let Some(note) = &in_sample {
-        writeln!(md, "\n**Note**: {note}.")?;
-    }
+    sheet.by_method()?.write_figure(&out.join(&image))?;
+    let text = Text { figure, label, column, image: &image, in_sample: in_sample.as_deref() };
+    let (csv, md) = text.write(&model, &train, &shown, &sheet, &config)?;
     write_atomic(&out.join(format!("fig{figure}.csv")), csv.as_bytes())?;
     write_atomic(&out.join("summary.md"), md.as_bytes())?;
     print!("{md}");
