@@ -12,6 +12,7 @@
 //! [`Attributes`]: crate::attributes::Attributes
 
 pub mod analytic;
+pub mod interpolation;
 pub mod known;
 pub mod lobe;
 pub mod measures;

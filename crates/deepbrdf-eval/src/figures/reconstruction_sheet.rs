@@ -1,7 +1,8 @@
 //! The reconstruction figures of Hu et al. (2020): a few materials rendered as measured and as
 //! each representation reconstructs them, the image RelAE of each reconstruction under its
-//! tile ([`ImageRelae`] on the preview sphere under sun and sky): Fig. 6 (§4: DeepBRDF, PCA and
-//! IPCA at several k), Figs. 8 and 9 (§4.2: DeepBRDF against Sun et al. 2018 and IPCA). The
+//! tile ([`ImageRelae`] on the preview sphere under sun and sky): Fig. 4 (§3.3: the L2 and L1
+//! models), Fig. 6 (§4: DeepBRDF, PCA and IPCA at several k), Figs. 8 and 9 (§4.2: DeepBRDF
+//! against Sun et al. 2018 and IPCA). The
 //! renderer's noise is measured beside it: the RelAE between two renders of each measurement
 //! with different seeds (an upper bound: a reconstruction is rendered with the measurement's
 //! seed and sampling, so most noise cancels in its RelAE).
@@ -82,11 +83,12 @@ impl ReconstructionSheet {
         Ok(Self { originals, noise, columns })
     }
 
-    /// A row per material: the measurement, then each method's reconstruction (Fig. 6).
-    pub fn by_material(&self) -> Result<Srgb8Image> {
+    /// A row per material of `rows` (indices into the input's materials): the measurement,
+    /// then each method's reconstruction (Figs. 4 and 6).
+    pub fn by_material(&self, rows: &[usize]) -> Result<Srgb8Image> {
         let mut tiles = Vec::new();
-        for (s, original) in self.originals.iter().enumerate() {
-            tiles.push(original.clone());
+        for &s in rows {
+            tiles.push(self.originals[s].clone());
             tiles.extend(self.columns.iter().map(|c| c.tiles[s].clone()));
         }
         Ok(contact_sheet(&tiles, &sheet_config(1 + self.columns.len() as u32))?)

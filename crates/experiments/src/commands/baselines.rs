@@ -5,6 +5,7 @@
 use crate::args::data::DataArgs;
 use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
+use deepbrdf_data::dataset::Dataset;
 use deepbrdf_data::Progress;
 use deepbrdf_eval::attributes::AttributeMethod;
 use deepbrdf_eval::baseline::BaselineMethod;
@@ -106,62 +107,14 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         only_fold: args.fold,
     };
     config.validate()?;
-    if args.save_basis.is_some() && matches!(args.mode, Mode::KFold { .. }) {
-        bail!("--save-basis needs in-sample or generalize mode (k-fold fits one basis per fold)");
-    }
-    if args.mode != Mode::Generalize && args.eval_collections != default_eval_collections() {
-        bail!("--eval-collections is for generalize mode only");
-    }
-    for m in &args.methods {
-        if !["pca", "ipca", "sun2018", "ggx", "deepbrdf"].contains(&m.as_str()) {
-            bail!("unknown method '{m}' (pca, ipca, sun2018, ggx, deepbrdf)");
-        }
-    }
-    if args.methods.iter().any(|m| m == "ggx") && args.ks != [7] {
-        bail!("the ggx method has exactly 7 parameters: run it with --k 7");
-    }
+    check(&args)?;
     let out = args.out.clone().unwrap_or_else(|| default_out(args.mode));
     // Held until the run ends: a second run on the same folder is refused.
     let _lock = deepbrdf_data::lock::FolderLock::acquire(&out)?;
     // Refuse before any work, so a long run never ends by refusing to write.
     check_not_overwriting(&out, &RESULT_FILES, args.force, "results of an earlier run")?;
-    let (pca, ipca) = (BaselineMethod::pca(), BaselineMethod::ipca());
-    let (pca, ipca) = match &args.save_basis {
-        Some(dir) => {
-            let names = [format!("{}.basis", pca.name()), format!("{}.basis", ipca.name())];
-            let names: Vec<&str> = names.iter().map(String::as_str).collect();
-            check_not_overwriting(dir, &names, args.force, "a saved basis")?;
-            (pca.keeping_last_fit(), ipca.keeping_last_fit())
-        }
-        None => (pca, ipca),
-    };
-
-    let t = Instant::now();
-    let train = args.data.load(progress)?;
-    eprintln!(
-        "loaded {} ({} materials) in {:.1} s",
-        train.label,
-        train.len(),
-        t.elapsed().as_secs_f64()
-    );
-    let eval = if args.mode == Mode::Generalize {
-        let t = Instant::now();
-        let eval =
-            crate::args::data::load_collections(&args.eval_collections, &args.data, progress)?;
-        eprintln!(
-            "loaded {} ({} materials) in {:.1} s",
-            eval.label,
-            eval.len(),
-            t.elapsed().as_secs_f64()
-        );
-        Some(eval)
-    } else {
-        None
-    };
-
-    let added = (!args.add_collections.is_empty())
-        .then(|| crate::args::data::load_added(&args.add_collections, &args.data.cache(), progress))
-        .transpose()?;
+    let (pca, ipca) = linear_methods(&args)?;
+    let (train, added, eval) = load(&args, progress)?;
     let train_label = format!("{} ({} materials)", train.label, train.len());
     let added_label =
         added.as_ref().map(|a| format!("{} ({} materials)", a.label, a.len())).unwrap_or_default();
@@ -176,17 +129,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         specular_epsilon: args.sun_specular_epsilon,
         ..SeparationConfig::default()
     });
-    let preset = args.preset;
-    let models = args.models.clone().unwrap_or_else(|| out.join("models"));
-    let deep = DeepMethod::new(
-        Box::new(move |k| preset.train_config(k)),
-        &models,
-        &data_label,
-        crate::args::device::device()?,
-    )
-    .retaining(&[])
-    .refining(args.refine.refinement()?)
-    .training_within(args.time_limit);
+    let deep = deep_method(&args, &out, &data_label)?;
     let methods: Vec<&dyn Method> = args
         .methods
         .iter()
@@ -223,7 +166,12 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             .collect();
         save_bases(dir, &kept)?;
     }
+    print_results(&results, &out, started);
+    Ok(())
+}
 
+/// What the run measured, its times and where the results are.
+fn print_results(results: &harness::Results, out: &Path, started: Instant) {
     println!(
         "{} mode: trained on {}, evaluated on {}\n",
         results.mode, results.train_label, results.eval_label
@@ -237,7 +185,80 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         started.elapsed().as_secs_f64()
     );
     println!("results written to {}", out.display());
+}
+
+/// PCA and IPCA, keeping their last fit where `--save-basis` asks (refused before any work
+/// where that would overwrite a saved basis).
+fn linear_methods(args: &Args) -> anyhow::Result<(BaselineMethod, BaselineMethod)> {
+    let (pca, ipca) = (BaselineMethod::pca(), BaselineMethod::ipca());
+    let Some(dir) = &args.save_basis else { return Ok((pca, ipca)) };
+    let names = [format!("{}.basis", pca.name()), format!("{}.basis", ipca.name())];
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    check_not_overwriting(dir, &names, args.force, "a saved basis")?;
+    Ok((pca.keeping_last_fit(), ipca.keeping_last_fit()))
+}
+
+/// DeepBRDF trained with the preset for each k (its models under `--models`, else
+/// `out/models`), encoding with the refinement asked.
+fn deep_method(args: &Args, out: &Path, data_label: &str) -> anyhow::Result<DeepMethod> {
+    let preset = args.preset;
+    let models = args.models.clone().unwrap_or_else(|| out.join("models"));
+    Ok(DeepMethod::new(
+        Box::new(move |k| preset.train_config(k)),
+        &models,
+        data_label,
+        crate::args::device::device()?,
+    )
+    .retaining(&[])
+    .refining(args.refine.refinement()?)
+    .training_within(args.time_limit))
+}
+
+/// Refuses option combinations that cannot run, before any work.
+fn check(args: &Args) -> anyhow::Result<()> {
+    if args.save_basis.is_some() && matches!(args.mode, Mode::KFold { .. }) {
+        bail!("--save-basis needs in-sample or generalize mode (k-fold fits one basis per fold)");
+    }
+    if args.mode != Mode::Generalize && args.eval_collections != default_eval_collections() {
+        bail!("--eval-collections is for generalize mode only");
+    }
+    for m in &args.methods {
+        if !["pca", "ipca", "sun2018", "ggx", "deepbrdf"].contains(&m.as_str()) {
+            bail!("unknown method '{m}' (pca, ipca, sun2018, ggx, deepbrdf)");
+        }
+    }
+    if args.methods.iter().any(|m| m == "ggx") && args.ks != [7] {
+        bail!("the ggx method has exactly 7 parameters: run it with --k 7");
+    }
     Ok(())
+}
+
+/// The training set, the collections added to training, and (generalize mode) the evaluation
+/// set, each load's time printed.
+fn load(
+    args: &Args,
+    progress: &dyn Progress,
+) -> anyhow::Result<(Dataset, Option<Dataset>, Option<Dataset>)> {
+    let loaded = |set: &Dataset, t: Instant| {
+        let secs = t.elapsed().as_secs_f64();
+        eprintln!("loaded {} ({} materials) in {secs:.1} s", set.label, set.len());
+    };
+    let t = Instant::now();
+    let train = args.data.load(progress)?;
+    loaded(&train, t);
+    let eval = if args.mode == Mode::Generalize {
+        let t = Instant::now();
+        let eval =
+            crate::args::data::load_collections(&args.eval_collections, &args.data, progress)?;
+        loaded(&eval, t);
+        Some(eval)
+    } else {
+        None
+    };
+    let added = (!args.add_collections.is_empty())
+        .then(|| crate::args::data::load_added(&args.add_collections, &args.data.cache(), progress))
+        .transpose()?;
+    Ok((train, added, eval))
 }
 
 fn default_eval_collections() -> Vec<Collection> {

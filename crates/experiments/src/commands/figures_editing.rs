@@ -23,7 +23,6 @@
 //!   re-estimated roughness along each Fig. 13/14 sweep.
 //!
 //! Writes `results.md` (the tables), `suite.csv` (every material and edit) and the figures.
-use super::interpolate::{self, Path3};
 use crate::args::data::DataArgs;
 use crate::editing::{self, EditMode, EditorArg, ModelCodec, Space};
 use anyhow::Context;
@@ -31,8 +30,10 @@ use deepbrdf_data::dataset::{DataSource, Dataset};
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::attributes::{Attributes, FitConfig};
 use deepbrdf_eval::baseline::BaselineCodec;
+use deepbrdf_eval::editing::interpolation::{self, InterpolationPath as Path3};
 use deepbrdf_eval::editing::suite::{self, report, Suite, SuiteInput, SuiteRepresentation as Rep};
 use deepbrdf_eval::editing::{is_monotone, ColourEdit, Edit, ScalarEdit};
+use deepbrdf_eval::figures::{figure_caption, strip};
 use deepbrdf_eval::metrics::{ImageRelae, ImageRelaeConfig};
 use deepbrdf_eval::separation::{self, SeparatedBasis};
 use deepbrdf_model::DeepBrdf;
@@ -122,7 +123,7 @@ impl Figures<'_> {
     /// Fig. 10: red-metallic-paint to red-fabric in 9 steps, with its section of `md`.
     fn fig10(&self, md: &mut String) -> anyhow::Result<()> {
         let (a, b) = (self.index("red-metallic-paint")?, self.index("red-fabric")?);
-        let paths = interpolate::paths(
+        let paths = interpolation::paths(
             self.model,
             Some(self.ipca),
             &self.set.tables[a],
@@ -130,8 +131,8 @@ impl Figures<'_> {
             9,
             self.progress,
         )?;
-        let refs: Vec<&Path3> = paths.iter().collect();
-        let (sheet, noise) = interpolate::strip(
+        let refs: Vec<&[MerlTable]> = paths.iter().map(|p| p.tables.as_slice()).collect();
+        let (sheet, noise) = strip(
             &refs,
             &|row, i| format!("{} t={:.3}", paths[row].name, i as f64 / 8.0),
             &self.figure,
@@ -140,9 +141,9 @@ impl Figures<'_> {
         let _ = write!(
             md,
             "## Fig. 10: red-metallic-paint to red-fabric, 9 steps\n\n![Fig. 10](fig10_interpolation.jpg)\n\n{}\n\nImage RelAE between consecutive steps (128 px sphere, sun and sky, 16 spp):\n\n",
-            interpolate::figure_caption(&self.figure, noise)
+            figure_caption(&self.figure, noise)
         );
-        *md += &interpolate::summary(&paths)?;
+        *md += &interpolation::summary(&paths)?;
         Ok(())
     }
 
@@ -166,24 +167,24 @@ impl Figures<'_> {
         for mode in [EditMode::Paper, EditMode::Residual, EditMode::Stretch] {
             let mut tables = vec![self.set.tables[g].clone()];
             tables.extend(sweep(self.deep, &self.set.tables[g], &self.attrs[g], &edits, mode)?);
-            let images = interpolate::render_all(&reference, &tables)?;
+            let images = interpolation::render_all(&reference, &tables)?;
             let name = match mode.needs_network() {
                 true => format!("DeepBRDF {}", mode.name()),
                 false => mode.name().to_string(),
             };
             rows.push(Path3 { name, tables, images });
         }
-        let refs: Vec<&Path3> = rows.iter().collect();
+        let refs: Vec<&[MerlTable]> = rows.iter().map(|p| p.tables.as_slice()).collect();
         let captions = |row: usize, i: usize| match i {
             0 => "original".into(),
             _ => format!("{} {}", rows[row].name.trim_start_matches("DeepBRDF "), colours[i - 1].0),
         };
-        let (sheet, noise) = interpolate::strip(&refs, &captions, &self.figure)?;
+        let (sheet, noise) = strip(&refs, &captions, &self.figure)?;
         sheet.write_figure(&self.out.join("fig12_diffuse.jpg"))?;
         let _ = write!(
             md,
             "\n## Fig. 12: diffuse albedo of gray-plastic\n\n![Fig. 12](fig12_diffuse.jpg)\n\n{}\n\nRows: the paper's edit, the residual edit (DeepBRDF), the stretch edit (no network: the diffuse albedo as the analytic edit sets it); first column the measurement. Requested vs re-estimated diffuse albedo:\n\n| edit | requested | paper: achieved | residual: achieved | stretch: achieved |\n| --- | --- | --- | --- | --- |\n",
-            interpolate::figure_caption(&self.figure, noise)
+            figure_caption(&self.figure, noise)
         );
         for (i, (name, c)) in colours.iter().enumerate() {
             let got: Vec<String> = rows
@@ -254,22 +255,22 @@ impl Figures<'_> {
                     shown.join(" "),
                     if is_monotone(&got, true, 0.0) { "yes" } else { "no" }
                 );
-                let images = interpolate::render_all(&reference, &tables)?;
+                let images = interpolation::render_all(&reference, &tables)?;
                 let name = match mode.needs_network() {
                     true => format!("{} {}", rep.name, mode.name()),
                     false => mode.name().to_string(),
                 };
                 rows.push(Path3 { name, tables, images });
             }
-            let refs: Vec<&Path3> = rows.iter().collect();
+            let refs: Vec<&[MerlTable]> = rows.iter().map(|p| p.tables.as_slice()).collect();
             let captions = |row: usize, i: usize| format!("{} x{:.2}", rows[row].name, usable[i].0);
-            let (sheet, noise) = interpolate::strip(&refs, &captions, &self.figure)?;
+            let (sheet, noise) = strip(&refs, &captions, &self.figure)?;
             sheet.write_figure(&self.out.join(format!("{fig}.jpg")))?;
             let _ = write!(
                 md,
                 "\n## {}: roughness of {material}\n\n![{fig}]({fig}.jpg)\n\n{}\n\nRows: {}; columns: roughness x{}.\n",
                 if fig.starts_with("fig13") { "Fig. 13" } else { "Fig. 14" },
-                interpolate::figure_caption(&self.figure, noise),
+                figure_caption(&self.figure, noise),
                 rows.iter().map(|r| r.name.as_str()).collect::<Vec<_>>().join(", "),
                 usable.iter().map(|(s, _)| format!("{s:.2}")).collect::<Vec<_>>().join(", x")
             );

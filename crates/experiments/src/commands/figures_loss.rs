@@ -10,13 +10,12 @@ use crate::editing::ModelCodec;
 use anyhow::{bail, Context};
 use deepbrdf_data::dataset::{DataSource, Dataset};
 use deepbrdf_data::files::write_atomic;
-use deepbrdf_data::Progress;
+use deepbrdf_data::{MerlTable, Progress};
+use deepbrdf_eval::figures::{ReconstructionSheet, SheetInput};
 use deepbrdf_eval::harness::Codec;
-use deepbrdf_eval::metrics::{relae, ImageRelae};
+use deepbrdf_eval::metrics::ImageRelaeConfig;
 use deepbrdf_eval::stats::finite_mean;
 use deepbrdf_model::{DeepBrdf, TrainConfig};
-use deepbrdf_render::sheet::{contact_sheet, SheetConfig, Tile};
-use deepbrdf_render::Tonemap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -83,41 +82,49 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         .collect();
     let shown = spaced(data.len(), args.show as usize);
 
-    let tonemap = Tonemap::default();
-    let srgb = |img: &deepbrdf_render::Image| img.to_srgb8(&tonemap, [0, 0, 0]);
-    // errors[m][i]: model m on material i; tiles in rows of shown materials.
-    let mut errors = vec![Vec::with_capacity(data.len()); models.len()];
-    let (mut noise, mut tiles) = (Vec::with_capacity(data.len()), vec![]);
-    progress.start((data.len() * (2 + models.len())) as u64, "rendering Fig. 4");
-    for (i, (name, table)) in data.names.iter().zip(&data.tables).enumerate() {
-        let measure = ImageRelae::new(table, &config)?;
-        noise.push(measure.noise(table)?);
-        progress.advance(2);
-        let show = shown.contains(&i);
-        if show {
-            tiles.push(Tile { image: srgb(measure.reference()), caption: name.clone() });
-        }
-        for (m, (model, label)) in models.iter().enumerate() {
-            let codec = ModelCodec(model);
-            let image = measure.render(&codec.decode(&codec.encode(table)?)?)?;
-            let e = relae(&image, measure.reference())?;
-            errors[m].push(e);
-            if show {
-                tiles.push(Tile { image: srgb(&image), caption: format!("{label}: RelAE {e:.3}") });
-            }
-            progress.advance(1);
-        }
-    }
-    progress.finish();
+    let codecs: Vec<ModelCodec> = models.iter().map(|(m, _)| ModelCodec(m)).collect();
+    let methods: Vec<(&str, &dyn Codec)> = models
+        .iter()
+        .zip(&codecs)
+        .map(|((_, label), codec)| (label.as_str(), codec as &dyn Codec))
+        .collect();
+    let names: Vec<&str> = data.names.iter().map(String::as_str).collect();
+    let tables: Vec<&MerlTable> = data.tables.iter().collect();
+    let caption = |label: &str, _k: usize, e: f64| format!("{label}: RelAE {e:.3}");
+    let input = SheetInput {
+        names: &names,
+        tables: &tables,
+        methods: &methods,
+        config: &config,
+        background: [0, 0, 0],
+        caption: &caption,
+    };
+    let sheet = ReconstructionSheet::measure(&input, progress).context("Fig. 4")?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
-    let sheet = SheetConfig {
-        columns: 1 + models.len() as u32,
-        caption_height: 22,
-        font_px: 15,
-        ..Default::default()
-    };
-    contact_sheet(&tiles, &sheet)?.write_figure(&args.out.join("fig4.jpg"))?;
+    sheet.by_material(&shown)?.write_figure(&args.out.join("fig4.jpg"))?;
+    let (csv, md) = texts(&models, &data, &source.label(), &shown, &seen, &sheet, &config)?;
+    write_atomic(&args.out.join("fig4.csv"), csv.as_bytes())?;
+    write_atomic(&args.out.join("summary.md"), md.as_bytes())?;
+    print!("{md}");
+    eprintln!("wrote {}/fig4.jpg, fig4.csv, summary.md", args.out.display());
+    Ok(())
+}
+
+/// The figure's CSV and summary: per material its render noise and each model's image RelAE,
+/// each model's mean and how often it is the lowest, and how the figure was made.
+fn texts(
+    models: &[(DeepBrdf, String)],
+    data: &Dataset,
+    source: &str,
+    shown: &[usize],
+    seen: &[&String],
+    sheet: &ReconstructionSheet,
+    config: &ImageRelaeConfig,
+) -> anyhow::Result<(String, String)> {
+    // errors[m][i]: model m on material i.
+    let errors: Vec<&Vec<f64>> = sheet.columns.iter().map(|c| &c.relae).collect();
+    let noise = &sheet.noise;
 
     let labels: Vec<&str> = models.iter().map(|(_, l)| l.as_str()).collect();
     let mut csv = format!(
@@ -182,18 +189,14 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
          its random numbers with the measurement's, so its noise is below that.\n\n{lines}\n\
          ![Fig. 4](fig4.jpg)\n\n{table}",
         data.len(),
-        source.label(),
+        source,
         shown.len(),
         size = config.render.size,
         spp = config.render.spp,
         seed = config.render.seed,
         seed2 = config.next_seed().render.seed,
     );
-    write_atomic(&args.out.join("fig4.csv"), csv.as_bytes())?;
-    write_atomic(&args.out.join("summary.md"), md.as_bytes())?;
-    print!("{md}");
-    eprintln!("wrote {}/fig4.jpg, fig4.csv, summary.md", args.out.display());
-    Ok(())
+    Ok((csv, md))
 }
 
 #[cfg(test)]

@@ -167,7 +167,8 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         caption: &caption,
     };
     let sheet = ReconstructionSheet::measure(&input, progress).context("Fig. 6")?;
-    sheet.by_material()?.write_figure(&args.out.join("fig6.jpg"))?;
+    let rows: Vec<usize> = (0..names.len()).collect();
+    sheet.by_material(&rows)?.write_figure(&args.out.join("fig6.jpg"))?;
     let (csv6, table) = fig6_csv_and_table(&sheet, &names);
     write_atomic(&args.out.join("fig6.csv"), csv6.as_bytes())?;
     let md = summary(&args, &model, &set, &choice, &seen, &map, &sheet, &config, &table, started);

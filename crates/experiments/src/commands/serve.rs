@@ -4,9 +4,7 @@
 //! latent. Binds 127.0.0.1 unless told otherwise; see [`crate::serve`].
 use crate::args::data::CacheArg;
 use crate::editing::EditorArg;
-use crate::serve::editor::EditorHandle;
-use crate::serve::request::{bundled_ids, Catalogue};
-use anyhow::Context;
+use crate::serve::launch::{runtime, start};
 use deepbrdf_data::Progress;
 use std::io::Write;
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
@@ -23,30 +21,6 @@ pub struct Args {
     pub port: u16,
     #[command(flatten)]
     pub cache: CacheArg,
-}
-
-/// Starts the editor (model and regressor loaded) and binds `addr`: the listener and the
-/// handle, shared by `serve` and `bench serve`.
-pub fn start(
-    runtime: &tokio::runtime::Runtime,
-    editor: &EditorArg,
-    cache: &CacheArg,
-    addr: SocketAddr,
-) -> anyhow::Result<(tokio::net::TcpListener, EditorHandle)> {
-    let model_dir = editor.model.dir()?;
-    let catalogue = Catalogue::new(bundled_ids()?);
-    let editor =
-        EditorHandle::start(&model_dir, editor.regressor.as_deref(), cache.cache(), catalogue)?;
-    let listener = runtime
-        .block_on(tokio::net::TcpListener::bind(addr))
-        .with_context(|| format!("listening on {addr}"))?;
-    Ok((listener, editor))
-}
-
-/// The runtime of the server: two worker threads answer HTTP while the editor thread and
-/// rayon render.
-pub fn runtime() -> anyhow::Result<tokio::runtime::Runtime> {
-    Ok(tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?)
 }
 
 pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {

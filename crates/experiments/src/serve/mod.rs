@@ -17,6 +17,7 @@
 //! request names is read from or written to disk except the server's cache (bundled materials
 //! are named by id, uploads are parsed in memory).
 pub mod editor;
+pub mod launch;
 mod queue;
 mod recent;
 mod replies;

@@ -7,8 +7,8 @@
 //! worst case: the page itself keeps one in flight), with the page and `/api/info` fetched
 //! during the burst.
 use crate::args::data::CacheArg;
-use crate::commands::serve::{runtime, start};
 use crate::editing::EditorArg;
+use crate::serve::launch::{runtime, start};
 use anyhow::{bail, Context};
 use deepbrdf_data::Progress;
 use deepbrdf_eval::stats::finite_median;
