@@ -212,15 +212,7 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
         _ => None,
     };
     let loaded_at = started.elapsed().as_secs_f64();
-    let sample = config_for(deep_ks[0]);
-    let training = match &args.train_config {
-        Some(path) => format!("configuration {}", path.display()),
-        None => format!("preset {}", args.preset),
-    };
-    let training = format!(
-        "{training}, {} epochs, batch {}, lr {:.1e}, seed {}, device {kind}",
-        sample.epochs, sample.batch_size, sample.learning_rate, args.seed
-    );
+    let training = training_label(&args, &config_for(deep_ks[0]), &kind.to_string());
     println!(
         "sweep-k: {} materials ({}), PCA and IPCA at k = {:?}, DeepBRDF at k = {deep_ks:?}, {} mode, {training}; output in {}",
         data.names.len(),
@@ -282,15 +274,33 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
         loaded_at,
         wall,
     };
+    write_report(&args, &report, &out)
+}
+
+/// How DeepBRDF is trained, for the report: the preset or configuration file, and `sample`'s
+/// (the first k's) epochs, batch, learning rate, the seed and the device.
+fn training_label(args: &Args, sample: &TrainConfig, device: &str) -> String {
+    let training = match &args.train_config {
+        Some(path) => format!("configuration {}", path.display()),
+        None => format!("preset {}", args.preset),
+    };
+    format!(
+        "{training}, {} epochs, batch {}, lr {:.1e}, seed {}, device {device}",
+        sample.epochs, sample.batch_size, sample.learning_rate, args.seed
+    )
+}
+
+/// Writes the summary (and the README's results block where asked) and prints the report.
+fn write_report(args: &Args, report: &SweepReport, out: &Path) -> anyhow::Result<()> {
     write_atomic(&out.join("summary.md"), report.summary_markdown().as_bytes())?;
     if let Some(readme) = &args.update_readme {
-        let block = report.readme_block(&relative_link(readme, &out)?);
+        let block = report.readme_block(&relative_link(readme, out)?);
         let (begin, end) = readme_markers(args.mode);
         readme_block::update_file(readme, begin, end, &block)?;
         println!("updated the results block of {}", readme.display());
     }
     print!("{}", report.printed());
-    println!("wrote {}; total wall time {}", out.display(), minutes(wall));
+    println!("wrote {}; total wall time {}", out.display(), minutes(report.wall));
     Ok(())
 }
 
