@@ -9,16 +9,13 @@ use crate::util::{self, s};
 fn corpus_training_and_known_answer_edits() {
     let dir = tempfile::tempdir().unwrap();
     let data = util::write_data(dir.path(), 4);
-    let ok = |args: &[&str]| {
-        let out = util::run_ok(dir.path(), args);
-        (util::stdout(&out), util::stderr(&out))
-    };
+    let ok = util::runner(dir.path());
     let corpus = dir.path().join("corpus");
     ok(&["corpus", "--count", "40", "--seed", "5", "--out", &s(&corpus)]);
     let file = s(&corpus.join("corpus.jsonl"));
     let config = util::tiny_config(dir.path());
     let run = dir.path().join("run");
-    let (_, err) = ok(&[
+    let err = util::stderr(&ok(&[
         "train",
         "--config",
         &s(&config),
@@ -32,7 +29,7 @@ fn corpus_training_and_known_answer_edits() {
         "2",
         "--out",
         &s(&run),
-    ]);
+    ]));
     assert!(err.contains("(6 BRDFs)") && err.contains("corpus(2 of corpus.jsonl)"), "{err}");
     let saved = std::fs::read_to_string(run.join("train_config.json")).unwrap();
     assert!(saved.contains("\"held_passes\": 2"), "{saved}");
@@ -52,7 +49,7 @@ fn corpus_training_and_known_answer_edits() {
         "--ipca",
     ]);
     let out = dir.path().join("known");
-    let (printed, _) = ok(&[
+    let printed = util::stdout(&ok(&[
         "edit-known",
         "--model",
         &model,
@@ -66,7 +63,7 @@ fn corpus_training_and_known_answer_edits() {
         &s(&out),
         "--methods",
         "analytic,stretch,deepbrdf-residual,deepbrdf-paper,ipca-residual,deepbrdf-transfer,deepbrdf-transfer-paper,ipca-transfer,sun2018-stretch",
-    ]);
+    ]));
     assert!(printed.contains("| analytic | **all** |"), "{printed}");
     let csv = std::fs::read_to_string(out.join("known.csv")).unwrap();
     let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();

@@ -12,7 +12,7 @@ use crate::util::s;
 fn train_a_regressor_edit_and_interpolate() {
     let dir = tempfile::tempdir().unwrap();
     let data = util::write_data(dir.path(), 3);
-    let ok = |args: &[&str]| util::stdout(&util::run_ok(dir.path(), args));
+    let ok = util::runner(dir.path());
     let mut runs = Vec::new();
     for seed in [0u64, 1] {
         let config = util::tiny_train_config().with_seed(seed);
@@ -23,7 +23,7 @@ fn train_a_regressor_edit_and_interpolate() {
         runs.push(run);
     }
     let (model, other) = (s(&runs[0]), s(&runs[1]));
-    let printed = ok(&[
+    let printed = util::stdout(&ok(&[
         "train-regressor",
         "--model",
         &model,
@@ -32,7 +32,7 @@ fn train_a_regressor_edit_and_interpolate() {
         "--epochs",
         "30",
         "--ipca",
-    ]);
+    ]));
     assert!(printed.contains("training relative error"), "{printed}");
     let regressor = runs[0].join("regressor");
     assert!(
@@ -49,7 +49,7 @@ fn train_a_regressor_edit_and_interpolate() {
     let m1 = s(&data.join("m1.binary"));
     for mode in ["paper", "residual"] {
         let edited = dir.path().join(format!("edited-{mode}.binary"));
-        let printed = ok(&[
+        let printed = util::stdout(&ok(&[
             "edit",
             "--model",
             &model,
@@ -66,7 +66,7 @@ fn train_a_regressor_edit_and_interpolate() {
             "16",
             "--spp",
             "1",
-        ]);
+        ]));
         assert!(printed.contains("requested") && printed.contains("achieved"), "{printed}");
         assert_eq!(read_merl(&edited).unwrap().mask(), util::material(1).mask());
     }
@@ -129,7 +129,7 @@ fn train_a_regressor_edit_and_interpolate() {
     assert!(!dir.path().join("x.binary").exists());
 
     let strip = dir.path().join("interp");
-    let printed = ok(&[
+    let printed = util::stdout(&ok(&[
         "interpolate",
         "--model",
         &model,
@@ -139,9 +139,9 @@ fn train_a_regressor_edit_and_interpolate() {
         "3",
         "--out",
         &s(&strip),
-    ]);
+    ]));
     assert!(printed.contains("linear blend") && printed.contains("IPCA"), "{printed}");
     assert!(strip.join("strip.png").is_file() && strip.join("deepbrdf-02.binary").is_file());
-    let printed = ok(&["bench", "edit", "--model", &model, &m1, "--reps", "1"]);
+    let printed = util::stdout(&ok(&["bench", "edit", "--model", &model, &m1, "--reps", "1"]));
     assert!(printed.contains("one edit:"), "{printed}");
 }

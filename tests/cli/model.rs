@@ -17,7 +17,7 @@ fn train_encode_decode_and_reconstruct_a_slice_model() {
     let config_path = dir.path().join("tiny.json");
     config.save(&config_path).unwrap();
     let run = dir.path().join("run");
-    let ok = |args: &[&str]| util::run_ok(dir.path(), args);
+    let ok = util::runner(dir.path());
     ok(&["train", "--config", &s(&config_path), "--data", &s(&data), "--out", &s(&run)]);
 
     let m1 = s(&data.join("m1.binary"));

@@ -12,7 +12,7 @@ use crate::util::s;
 fn render_set_train_recovery_and_recover_chain() {
     let dir = tempfile::tempdir().unwrap();
     let data = util::write_data(dir.path(), 3);
-    let ok = |args: &[&str]| util::run_ok(dir.path(), args);
+    let ok = util::runner(dir.path());
     // A tiny `slice` model (k = 2) on the three materials.
     let config_path = util::tiny_config(dir.path());
     let model = dir.path().join("model");

@@ -15,7 +15,7 @@ fn the_shipped_model_encodes_decodes_edits_and_recovers_without_model_options() 
     let dir = tempfile::tempdir().unwrap();
     let data = util::write_data(dir.path(), 1);
     let m0 = s(&data.join("m0.binary"));
-    let ok = |args: &[&str]| util::run_ok(dir.path(), args);
+    let ok = util::runner(dir.path());
     let manifest: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(
             Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/default/model/model.json"),

@@ -64,6 +64,12 @@ pub fn run_ok(cwd: &Path, args: &[&str]) -> Output {
     out
 }
 
+/// A runner of successful commands in `cwd`: `ok(&[...])` runs `experiments` there ([`run_ok`]:
+/// asserts it succeeded) and returns its output.
+pub fn runner(cwd: &Path) -> impl Fn(&[&str]) -> Output + '_ {
+    move |args| run_ok(cwd, args)
+}
+
 /// Runs `experiments` with `args` in `cwd` (quiet) on `threads` rayon threads.
 pub fn run_on_threads(cwd: &Path, args: &[&str], threads: usize) -> Output {
     Command::new(env!("CARGO_BIN_EXE_experiments"))
