@@ -33,7 +33,7 @@ use deepbrdf_render::{
     camera_png, Photo, RenderSet, RenderSettings, Sampler, Shape, Srgb8Image, Tonemap,
 };
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// The methods, in table order.
 const METHODS: [&str; 4] = ["deepbrdf", "analytic", "nearest", "mean"];
@@ -152,14 +152,72 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     }
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
-    let mut rows = Vec::new();
-    let mut skipped = Vec::new();
-    let mut shown: Vec<Shown> = Vec::new();
-    let mut planes: Vec<Shown> = Vec::new();
+    let bench = Bench {
+        args: &args,
+        device: &device,
+        model: &model,
+        network: &network,
+        analytic: &analytic,
+        train: &train,
+        train_tables: &train_tables,
+        mean: &mean,
+        yardstick: &yardstick,
+        cache: &cache,
+    };
+    let mut found = Found::default();
     for (name, dir) in &sets {
+        bench.measure(name, dir, &mut found, progress)?;
+    }
+    let Found { rows, skipped, shown, planes } = &found;
+    write_outputs(&args, rows, skipped, shown, planes, &model, &network, &analytic)
+}
+
+/// What every test set is measured against: the networks, the training materials (the
+/// nearest-neighbour candidates and the training mean) and the yardstick of the mapped MSE.
+struct Bench<'a> {
+    args: &'a Args,
+    device: &'a deepbrdf_model::burn::tensor::Device,
+    model: &'a DeepBrdf,
+    network: &'a RecoveryArtifact,
+    analytic: &'a RecoveryArtifact,
+    train: &'a RenderSet,
+    train_tables: &'a std::collections::BTreeMap<String, MerlTable>,
+    mean: &'a MerlTable,
+    yardstick: &'a Yardstick,
+    cache: &'a deepbrdf_data::cache::Cache,
+}
+
+/// The results gathered over the test sets: a row per image, the images skipped per set
+/// (name, unusable, all) and the figures' tiles.
+#[derive(Default)]
+struct Found {
+    rows: Vec<Row>,
+    skipped: Vec<(String, usize, usize)>,
+    shown: Vec<Shown>,
+    planes: Vec<Shown>,
+}
+
+impl Bench<'_> {
+    /// Recovers every usable image of the test set `name` in `dir` by the four methods and
+    /// measures each against the truth; keeps a few for the figures.
+    fn measure(
+        &self,
+        name: &str,
+        dir: &Path,
+        found: &mut Found,
+        progress: &dyn Progress,
+    ) -> anyhow::Result<()> {
+        let (args, device) = (self.args, self.device);
+        let (model, network, analytic) = (self.model, self.network, self.analytic);
+        let (train_tables, mean, yardstick) = (self.train_tables, self.mean, self.yardstick);
+        let Found { rows, skipped, shown, planes } = found;
         let set = RenderSet::load(dir)?;
-        let overlap: Vec<&String> =
-            set.header.materials.iter().filter(|m| train.header.materials.contains(m)).collect();
+        let overlap: Vec<&String> = set
+            .header
+            .materials
+            .iter()
+            .filter(|m| self.train.header.materials.contains(m))
+            .collect();
         if !overlap.is_empty() {
             bail!(
                 "{}: {} of its materials (e.g. {}) are in the training set; not held out",
@@ -168,19 +226,19 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                 overlap[0]
             );
         }
-        let truth = load_tables(&set.header.materials, &cache, progress)?;
+        let truth = load_tables(&set.header.materials, self.cache, progress)?;
         let indices: Vec<usize> = (0..set.images.len()).collect();
         let side = network.config().input_side;
         let usable = set_images(&set, dir, &indices, side, progress)?;
         if let Some(note) = usable.note(dir) {
             eprintln!("{note}");
         }
-        skipped.push((name.clone(), usable.unusable.len(), indices.len()));
+        skipped.push((name.to_string(), usable.unusable.len(), indices.len()));
         let inputs = &usable.pixels;
-        let latents = network.predictor(&device)?.predict(inputs)?;
+        let latents = network.predictor(device)?.predict(inputs)?;
         let side7 = analytic.config().input_side;
         let attributes = if side7 == side {
-            analytic.predictor(&device)?.predict(inputs)?
+            analytic.predictor(device)?.predict(inputs)?
         } else {
             let again = set_images(&set, dir, &usable.indices, side7, progress)?;
             if again.indices != usable.indices {
@@ -189,14 +247,14 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                     dir.display()
                 );
             }
-            analytic.predictor(&device)?.predict(&again.pixels)?
+            analytic.predictor(device)?.predict(&again.pixels)?
         };
         let nearest = nearest_materials(
             &set,
             &usable.indices,
             inputs,
             side,
-            &train_tables,
+            train_tables,
             args.nn_spp,
             progress,
         )?;
@@ -264,7 +322,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
                 )?);
             }
             rows.push(Row {
-                set: name.clone(),
+                set: name.to_string(),
                 index: i,
                 material: image.material.clone(),
                 shape: image.scene.scene.shape.name(),
@@ -275,8 +333,8 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
             progress.advance(1);
         }
         progress.finish();
+        Ok(())
     }
-    write_outputs(&args, &rows, &skipped, &shown, &planes, &model, &network, &analytic)
 }
 
 #[allow(clippy::too_many_arguments)]
