@@ -25,9 +25,9 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 use crate::atomic::{check_format, read_limited, read_weights, write_manifest, write_weights};
+use crate::autoencoder::train::Trained;
 use crate::autoencoder::{retired_network, Autoencoder, AutoencoderConfig};
 use crate::error::{ModelError, Result};
-use crate::train::Trained;
 use deepbrdf_data::files::sync_dir_of;
 
 /// File name of the manifest.

@@ -9,10 +9,10 @@ use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::{MerlTable, Progress};
 
 use crate::artifact::{ModelArtifact, MODEL_DIR};
+use crate::autoencoder::train::{train_within, TrainConfig};
 use crate::codec::DeepBrdf;
 use crate::error::Result;
 use crate::streamed::StreamedTables;
-use crate::train::{train_within, TrainConfig};
 use crate::training_set::TrainingSet;
 
 /// Trains DeepBRDF on `tables` (named `names`, from the data source `label`), keeping the

@@ -34,6 +34,7 @@ pub mod training_set;
 
 pub use artifact::{ModelArtifact, Provenance};
 pub use autoencoder::slice::{augmentation, refine};
+pub use autoencoder::train::{train, train_within, SliceDropoutConfig, TrainConfig, Trained};
 pub use autoencoder::{Autoencoder, AutoencoderConfig};
 pub use burn;
 pub use codec::DeepBrdf;
@@ -44,5 +45,5 @@ pub use preset::Preset;
 pub use regressor::Regressor;
 pub use shipped::DEFAULT_MODEL_DIR;
 pub use streamed::StreamedTables;
-pub use train::{train, train_within, EpochRecord, SliceDropoutConfig, TrainConfig, Trained};
+pub use train::EpochRecord;
 pub use training_set::TrainingSet;

@@ -208,8 +208,9 @@ mod tests {
     #[test]
     fn a_streamed_corpus_trains_the_slice_network_beside_the_held_tables() {
         use crate::augmentation::AugmentationConfig;
+        use crate::autoencoder::train::{evaluate, train, TrainConfig};
         use crate::autoencoder::{Architecture, AutoencoderConfig, SliceConfig};
-        use crate::train::{adam, evaluate, train, TrainConfig};
+        use crate::train::adam;
         let dir = tempfile::tempdir().expect("tempdir");
         let path = dir.path().join("corpus.jsonl");
         write_corpus(&path, 11, 6, &Silent).expect("write");
@@ -266,7 +267,7 @@ mod tests {
         assert!(with < 0.8 * without, "corpus MSE {with} streamed vs {without} not");
         // More passes over the held BRDFs weigh them against the stream: they end better
         // represented. One pass is written as before the setting existed.
-        let held_mean = |t: &crate::train::Trained| {
+        let held_mean = |t: &crate::autoencoder::train::Trained| {
             t.per_material_mse.iter().sum::<f64>() / t.per_material_mse.len() as f64
         };
         let json = serde_json::to_string(&config).expect("json");

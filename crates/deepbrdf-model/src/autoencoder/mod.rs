@@ -18,6 +18,7 @@ mod init;
 mod limits;
 mod retired;
 pub mod slice;
+pub mod train;
 
 use burn::module::Param;
 use burn::prelude::*;

@@ -83,6 +83,11 @@ pub(super) fn saved_state(path: &Path) -> Result<TrainState> {
     state_of(&Container::load(path, CHECKPOINT_KIND)?, path)
 }
 
+/// The whole configuration of the run whose checkpoint is at `path`, as JSON.
+pub(crate) fn saved_run_config(path: &Path) -> Result<serde_json::Value> {
+    Ok(saved_state(path)?.config)
+}
+
 fn state_of(c: &Container, path: &Path) -> Result<TrainState> {
     let state = c.get("state").ok_or_else(|| missing(path, "training state"))?;
     serde_json::from_slice(state)

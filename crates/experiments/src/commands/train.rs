@@ -10,9 +10,10 @@ use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
 use deepbrdf_data::lock::FolderLock;
 use deepbrdf_data::Progress;
+use deepbrdf_model::autoencoder::train::saved_config;
 use deepbrdf_model::autoencoder::{Architecture, ConvAlgorithm};
 use deepbrdf_model::loss::LossNorm;
-use deepbrdf_model::train::{checkpoint_path, saved_config};
+use deepbrdf_model::train::checkpoint_path;
 use deepbrdf_model::{fit, Preset, SliceDropoutConfig, TrainConfig};
 use std::path::PathBuf;
 

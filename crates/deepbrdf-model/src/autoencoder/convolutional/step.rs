@@ -5,10 +5,10 @@
 use burn::optim::{GradientsParams, MultiGradientsParams};
 use burn::prelude::*;
 
+use crate::autoencoder::train::batch::{batch_tensors, Augment, Batch, SliceDropout};
+use crate::autoencoder::train::config::TrainConfig;
 use crate::autoencoder::Autoencoder;
 use crate::loss::{masked_error_centred, LossNorm};
-use crate::train::autoencoder::batch::{batch_tensors, Augment, Batch, SliceDropout};
-use crate::train::autoencoder::config::TrainConfig;
 use crate::train::run::TrainStep;
 use crate::training_set::TrainingSet;
 

@@ -12,7 +12,7 @@
 //! (the shipped `models/default` included). Renaming the Rust types alone would make the code
 //! and the files disagree; renaming both would orphan every saved model. In this module
 //! "slice" names the network; a single phi_d slice is called an image, and slice dropout is
-//! [`crate::train::SliceDropoutConfig`].
+//! [`crate::autoencoder::train::SliceDropoutConfig`].
 
 pub mod augmentation;
 pub mod basis;

@@ -21,12 +21,12 @@ use deepbrdf_data::layout::LAYOUT_VALUES;
 use super::augmentation::sample_layout;
 use super::basis::{basis_t, fit_slice_basis, fit_weighted_components, pixel_weights, project};
 use super::config::SliceConfig;
+use crate::autoencoder::train::batch::{centre, filled_input, SliceDropout};
+use crate::autoencoder::train::config::TrainConfig;
 use crate::autoencoder::Autoencoder;
 use crate::error::ModelError;
 use crate::loss::{colour_weights, LossNorm};
 use crate::streamed::mapped_layout;
-use crate::train::autoencoder::batch::{centre, filled_input, SliceDropout};
-use crate::train::autoencoder::config::TrainConfig;
 use crate::train::run::{on_device, TrainStep};
 use crate::training_set::TrainingSet;
 

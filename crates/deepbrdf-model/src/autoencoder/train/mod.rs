@@ -106,8 +106,8 @@ fn train_in(
         .map_err(|e| ModelError::Invalid(format!("cannot serialise the configuration: {e}")))?;
     let path = checkpoint_path(session.dir());
     if path.exists() && session.resumes() {
-        let saved = checkpoint::saved_state(&path)?;
-        if let Some(what) = saved.config.get("model").and_then(retired_network) {
+        let saved = checkpoint::saved_run_config(&path)?;
+        if let Some(what) = saved.get("model").and_then(retired_network) {
             return Err(ModelError::format(&path, retired_message(what)));
         }
     }

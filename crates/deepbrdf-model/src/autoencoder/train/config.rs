@@ -196,8 +196,8 @@ impl TrainConfig {
 /// The configuration of the run saved in `out_dir` (from its checkpoint), to resume it.
 pub fn saved_config(out_dir: &Path) -> crate::error::Result<TrainConfig> {
     let path = out_dir.join(CHECKPOINT_FILE);
-    let state = checkpoint::saved_state(&path)?;
-    serde_json::from_value(state.config)
+    let config = checkpoint::saved_run_config(&path)?;
+    serde_json::from_value(config)
         .map_err(|e| ModelError::format(&path, format!("bad configuration: {e}")))
 }
 
