@@ -14,8 +14,8 @@ use deepbrdf_model::autoencoder::train::saved_config;
 use deepbrdf_model::autoencoder::{Architecture, ConvAlgorithm};
 use deepbrdf_model::loss::LossNorm;
 use deepbrdf_model::train::checkpoint_path;
-use deepbrdf_model::{fit, Preset, SliceDropoutConfig, TrainConfig};
-use std::path::PathBuf;
+use deepbrdf_model::{fit, DeepBrdf, Preset, SliceDropoutConfig, TrainConfig};
+use std::path::{Path, PathBuf};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -149,43 +149,8 @@ impl Args {
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let device = crate::args::device::device()?;
     let kind = crate::args::device::kind()?;
-    let resume_dir = args.resume.clone().map(|d| d.or_else(|| args.out.clone()));
     // Held until the run ends: a second run on the same folder is refused.
-    let lock: FolderLock;
-    let (out, config, resume) = match resume_dir {
-        Some(None) => bail!("--resume needs a directory (--resume DIR or --out DIR --resume)"),
-        Some(Some(dir)) => {
-            if !checkpoint_path(&dir).is_file() {
-                bail!("{}: no interrupted run to resume (no checkpoint.bin)", dir.display());
-            }
-            lock = FolderLock::acquire(&dir)?;
-            let config = saved_config(&dir)?;
-            eprintln!(
-                "resuming {} (k = {}, {} epochs, batch {}, lr {:e})",
-                dir.display(),
-                config.model.latent,
-                config.epochs,
-                config.batch_size,
-                config.learning_rate
-            );
-            (dir, config, true)
-        }
-        None => {
-            let out = args.out.clone().context("--out DIR is required")?;
-            // The configuration first: a bad --config file leaves no folder behind.
-            let config = args.config()?;
-            lock = FolderLock::acquire(&out)?;
-            if checkpoint_path(&out).exists() {
-                bail!(
-                    "{} already holds a training run; continue it with --resume {} or choose \
-                     another --out",
-                    out.display(),
-                    out.display()
-                );
-            }
-            (out, config, false)
-        }
-    };
+    let (out, config, resume, lock) = run_folder(&args)?;
     let mut data = args.data.load(progress)?;
     if !args.add_collections.is_empty() {
         let more =
@@ -217,6 +182,53 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         progress,
         &device,
     )?;
+    print_trained(&model, &config, &out);
+    drop(lock);
+    Ok(())
+}
+
+/// The run's folder and configuration, whether it resumes, and the folder's lock: `--resume`
+/// continues the run whose checkpoint is there with its saved configuration; otherwise `--out`
+/// starts one with the configuration asked (read first: a bad `--config` file leaves no folder
+/// behind), refused where a run already is.
+fn run_folder(args: &Args) -> anyhow::Result<(PathBuf, TrainConfig, bool, FolderLock)> {
+    match args.resume.clone().map(|d| d.or_else(|| args.out.clone())) {
+        Some(None) => bail!("--resume needs a directory (--resume DIR or --out DIR --resume)"),
+        Some(Some(dir)) => {
+            if !checkpoint_path(&dir).is_file() {
+                bail!("{}: no interrupted run to resume (no checkpoint.bin)", dir.display());
+            }
+            let lock = FolderLock::acquire(&dir)?;
+            let config = saved_config(&dir)?;
+            eprintln!(
+                "resuming {} (k = {}, {} epochs, batch {}, lr {:e})",
+                dir.display(),
+                config.model.latent,
+                config.epochs,
+                config.batch_size,
+                config.learning_rate
+            );
+            Ok((dir, config, true, lock))
+        }
+        None => {
+            let out = args.out.clone().context("--out DIR is required")?;
+            let config = args.config()?;
+            let lock = FolderLock::acquire(&out)?;
+            if checkpoint_path(&out).exists() {
+                bail!(
+                    "{} already holds a training run; continue it with --resume {} or choose \
+                     another --out",
+                    out.display(),
+                    out.display()
+                );
+            }
+            Ok((out, config, false, lock))
+        }
+    }
+}
+
+/// What the run trained, and how to continue it where the time limit stopped it.
+fn print_trained(model: &DeepBrdf, config: &TrainConfig, out: &Path) {
     let p = model.provenance();
     println!(
         "trained {} epochs in {:.0} s: final loss {:.4e}, mapped-space MSE {:.4e} over {} BRDFs",
@@ -235,6 +247,4 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         );
     }
     println!("model {} written to {}", model.id(), out.join("model").display());
-    drop(lock);
-    Ok(())
 }

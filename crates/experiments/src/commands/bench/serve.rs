@@ -119,13 +119,65 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         refined.push(seconds);
     }
 
-    // The burst: 20 moves 50 ms apart, each sent at once from its own thread.
+    let Burst { answered, superseded, last_sent, last_done, page_max } =
+        burst(&client, &args.material, &value)?;
+
+    println!(
+        "{}, model {} (k = {}), {} rayon threads; server and model load {load:.2} s",
+        args.material,
+        model.model_id,
+        model.k,
+        rayon::current_num_threads()
+    );
+    println!("open the material (attribute fit, encode, table sampler): {open:.2} s; original render {original:.2} s");
+    println!(
+        "fast preview (128 px, {} spp), request to image over HTTP: median {:.3} s, max {:.3} s \
+         (target <= 0.300 s); in the editor: {:.3} s (decode {:.3} s, render {:.3} s), {} previews",
+        crate::serve::editor::FAST.spp,
+        finite_median(trip.clone()),
+        max(&trip),
+        finite_median(server),
+        finite_median(decode),
+        finite_median(render),
+        trip.len()
+    );
+    println!(
+        "refined preview (256 px, {} spp, own table sampler, re-estimated attributes): median {:.3} s",
+        crate::serve::editor::REFINED.spp,
+        finite_median(refined)
+    );
+    println!(
+        "burst of 20 moves in {last_sent:.2} s: {answered} answered, {superseded} superseded \
+         (409); the last answered {:.3} s after it was sent; page and /api/info during the \
+         burst: at most {page_max:.3} s",
+        last_done - last_sent
+    );
+    Ok(())
+}
+
+/// What the burst of moves measured: the previews answered and superseded, when the last was
+/// sent and answered (seconds from the start), and the slowest page or /api/info request.
+struct Burst {
+    answered: usize,
+    superseded: usize,
+    last_sent: f64,
+    last_done: f64,
+    page_max: f64,
+}
+
+/// The burst: 20 moves 50 ms apart (roughness `value(200 + i)`), each sent at once from its own
+/// thread, with the page and /api/info fetched during it.
+fn burst(
+    client: &Client,
+    material: &str,
+    value: &(dyn Fn(usize) -> f64 + Sync),
+) -> anyhow::Result<Burst> {
     let burst_start = Instant::now();
     let results = std::thread::scope(|s| {
         let handles: Vec<_> = (0..20)
             .map(|i| {
                 let client = &client;
-                let material = args.material.as_str();
+                let material = material;
                 s.spawn(move || {
                     std::thread::sleep(Duration::from_millis(50 * i as u64));
                     let sent = burst_start.elapsed().as_secs_f64();
@@ -159,36 +211,5 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     }
     let pages: Vec<(f64, f64)> = pages.into_iter().collect::<anyhow::Result<_>>()?;
     let page_max = pages.iter().map(|p| p.0.max(p.1)).fold(0.0, f64::max);
-
-    println!(
-        "{}, model {} (k = {}), {} rayon threads; server and model load {load:.2} s",
-        args.material,
-        model.model_id,
-        model.k,
-        rayon::current_num_threads()
-    );
-    println!("open the material (attribute fit, encode, table sampler): {open:.2} s; original render {original:.2} s");
-    println!(
-        "fast preview (128 px, {} spp), request to image over HTTP: median {:.3} s, max {:.3} s \
-         (target <= 0.300 s); in the editor: {:.3} s (decode {:.3} s, render {:.3} s), {} previews",
-        crate::serve::editor::FAST.spp,
-        finite_median(trip.clone()),
-        max(&trip),
-        finite_median(server),
-        finite_median(decode),
-        finite_median(render),
-        trip.len()
-    );
-    println!(
-        "refined preview (256 px, {} spp, own table sampler, re-estimated attributes): median {:.3} s",
-        crate::serve::editor::REFINED.spp,
-        finite_median(refined)
-    );
-    println!(
-        "burst of 20 moves in {last_sent:.2} s: {answered} answered, {superseded} superseded \
-         (409); the last answered {:.3} s after it was sent; page and /api/info during the \
-         burst: at most {page_max:.3} s",
-        last_done - last_sent
-    );
-    Ok(())
+    Ok(Burst { answered, superseded, last_sent, last_done, page_max })
 }
