@@ -14,7 +14,7 @@ use deepbrdf_eval::attributes::FitConfig;
 use deepbrdf_eval::baseline::{BaselineBasis, MappingKind};
 use deepbrdf_model::regressor::{RegressorData, Target, TargetKind};
 use deepbrdf_model::DeepBrdf;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 #[derive(Debug, clap::Args)]
@@ -46,18 +46,7 @@ pub struct Args {
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let started = Instant::now();
     let model_dir = args.model.dir()?;
-    let out = args.out.clone().unwrap_or_else(|| editing::regressor_dir(&model_dir, None));
-    for kind in [TargetKind::DeepBrdf, TargetKind::Ipca] {
-        let path = out.join(kind.file_name());
-        if path.exists() && !args.force && (kind == TargetKind::DeepBrdf || args.ipca) {
-            bail!("{} exists; pass --force to replace it", path.display());
-        }
-    }
-    if args.force && out.join("runs").exists() {
-        std::fs::remove_dir_all(out.join("runs"))
-            .with_context(|| format!("removing the old runs in {}", out.display()))?;
-    }
-    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let out = prepare_out(&args, &model_dir)?;
     let device = crate::args::device::device()?;
     let set = args.data.load(progress)?;
     let streamed = args.corpus.streamed()?;
@@ -75,24 +64,10 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         }
         false => None,
     };
-    let fit = FitConfig::default();
-    let total = set.len() + streamed.as_ref().map_or(0, |s| s.len());
-    let mut names = Vec::with_capacity(total);
-    let mut attributes = Vec::with_capacity(total);
-    let mut latents = Vec::with_capacity(total);
-    let mut coefficients = Vec::with_capacity(if ipca.is_some() { total } else { 0 });
-    let mut add = |name: &str, table: &MerlTable| -> anyhow::Result<()> {
-        attributes.push(editing::attributes_of(table, name, &fit)?.to_array());
-        latents.push(model.encode(table).with_context(|| format!("encoding {name}"))?);
-        if let Some(basis) = &ipca {
-            coefficients.push(basis.encode(table, k)?);
-        }
-        names.push(name.to_string());
-        Ok(())
-    };
+    let mut gathered = Gathered::new(&model, ipca.as_ref());
     progress.start(set.len() as u64, "attributes and latents");
     for (name, table) in set.names.iter().zip(&set.tables) {
-        add(name, table)?;
+        gathered.add(name, table)?;
         progress.advance(1);
     }
     progress.finish();
@@ -101,7 +76,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         progress.start(streamed.len() as u64, "attributes and latents of the streamed corpus");
         let mut failed = None;
         let streamed_result = streamed.for_each(progress, |_, name, table| {
-            add(name, &table).map_err(|e| {
+            gathered.add(name, &table).map_err(|e| {
                 failed = Some(e);
                 deepbrdf_model::ModelError::Invalid("stopped".into())
             })
@@ -113,7 +88,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         progress.finish();
         label = format!("{label}+{}", streamed.label());
     }
-    drop(add);
+    let Gathered { names, attributes, latents, coefficients, .. } = gathered;
     let config = config(args.epochs, args.seed);
     let data = RegressorData { label, names, attributes, targets: latents };
     let target = Target { kind: TargetKind::DeepBrdf, owner_id: model.id().to_string(), k };
@@ -126,4 +101,54 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     }
     println!("whole command {:.1} s", started.elapsed().as_secs_f64());
     Ok(())
+}
+
+/// The output folder, checked (an existing regressor is replaced only with `--force`, which
+/// also removes the old training runs) and created.
+fn prepare_out(args: &Args, model_dir: &Path) -> anyhow::Result<PathBuf> {
+    let out = args.out.clone().unwrap_or_else(|| editing::regressor_dir(model_dir, None));
+    for kind in [TargetKind::DeepBrdf, TargetKind::Ipca] {
+        let path = out.join(kind.file_name());
+        if path.exists() && !args.force && (kind == TargetKind::DeepBrdf || args.ipca) {
+            bail!("{} exists; pass --force to replace it", path.display());
+        }
+    }
+    if args.force && out.join("runs").exists() {
+        std::fs::remove_dir_all(out.join("runs"))
+            .with_context(|| format!("removing the old runs in {}", out.display()))?;
+    }
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    Ok(out)
+}
+
+/// The regression data gathered material by material: each one's fitted attributes (the
+/// inputs), its latent under the model and, where IPCA is trained too, its IPCA coefficients
+/// (the targets).
+struct Gathered<'a> {
+    model: &'a DeepBrdf,
+    ipca: Option<&'a BaselineBasis>,
+    fit: FitConfig,
+    names: Vec<String>,
+    attributes: Vec<[f64; 7]>,
+    latents: Vec<Vec<f32>>,
+    coefficients: Vec<Vec<f32>>,
+}
+
+impl<'a> Gathered<'a> {
+    fn new(model: &'a DeepBrdf, ipca: Option<&'a BaselineBasis>) -> Self {
+        let fit = FitConfig::default();
+        let (names, attributes, latents, coefficients) = (vec![], vec![], vec![], vec![]);
+        Self { model, ipca, fit, names, attributes, latents, coefficients }
+    }
+
+    fn add(&mut self, name: &str, table: &MerlTable) -> anyhow::Result<()> {
+        self.attributes.push(editing::attributes_of(table, name, &self.fit)?.to_array());
+        let latent = self.model.encode(table).with_context(|| format!("encoding {name}"))?;
+        self.latents.push(latent);
+        if let Some(basis) = self.ipca {
+            self.coefficients.push(basis.encode(table, self.model.k())?);
+        }
+        self.names.push(name.to_string());
+        Ok(())
+    }
 }
