@@ -8,14 +8,14 @@ use crate::args::model::ModelArg;
 use crate::recovery_inputs::{load_tables, set_images};
 use anyhow::bail;
 use deepbrdf_data::lock::FolderLock;
-use deepbrdf_data::Progress;
+use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::recovery::{attribute_fits, latents};
 use deepbrdf_model::recovery::artifact::RECOVERY_DIR;
 use deepbrdf_model::recovery::{
     train_recovery, RecoveryArtifact, RecoveryData, RecoveryPreset, RecoveryProvenance,
     RecoveryTarget,
 };
-use deepbrdf_model::train::Session;
+use deepbrdf_model::train::{LoopConfig, Session};
 use deepbrdf_model::DeepBrdf;
 use deepbrdf_render::RenderSet;
 use std::path::PathBuf;
@@ -63,33 +63,9 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let set = RenderSet::load(&args.set)?;
     let _lock = FolderLock::acquire(&args.out)?;
     let tables = load_tables(&set.header.materials, &args.cache.cache(), progress)?;
-    let (target, targets) = match args.target.as_str() {
-        "latent" => {
-            let dir = args.model.dir()?;
-            let model = DeepBrdf::load(&dir, &device)?;
-            let seen: Vec<&String> =
-                set.header.excluded.iter().filter(|m| model.provenance().trained_on(m)).collect();
-            if !seen.is_empty() {
-                eprintln!(
-                    "note: the model was trained on {} of the materials this set leaves out \
-                     (e.g. {}): the autoencoder has seen them",
-                    seen.len(),
-                    seen[0]
-                );
-            }
-            let target = RecoveryTarget::Latent { model_id: model.id().into(), k: model.k() };
-            (target, latents(&model, &tables)?)
-        }
-        _ => (RecoveryTarget::Attributes, attribute_fits(&tables, progress)?),
-    };
+    let (target, targets) = targets(&args, &set, &tables, &device, progress)?;
     let config = args.preset.network(target.outputs());
-    let mut settings = args.preset.loop_config().with_seed(args.seed);
-    if let Some(e) = args.epochs {
-        settings = settings.with_epochs(e);
-    }
-    if let Some(c) = args.checkpoint_seconds {
-        settings = settings.with_checkpoint_seconds(c);
-    }
+    let settings = loop_settings(&args);
     let indices: Vec<usize> = (0..set.images.len()).collect();
     let images = set_images(&set, &args.set, &indices, config.input_side, progress)?;
     if let Some(note) = images.note(&args.set) {
@@ -124,13 +100,14 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let artifact = RecoveryArtifact::new(config, target, &trained, provenance)?;
     let dir = args.out.join(RECOVERY_DIR);
     artifact.save(&dir)?;
+    let first = trained.log[0].loss;
     println!(
         "recovery CNN ({} preset, {} outputs) on {} images: L1 {:.4} -> {:.4} in {} epochs, \
          {:.0} s -> {} (id {})",
         args.preset,
         artifact.config().outputs,
         used,
-        trained.log[0].loss,
+        first,
         last.loss,
         trained.log.len(),
         trained.seconds,
@@ -138,4 +115,44 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         artifact.id()
     );
     Ok(())
+}
+
+/// What the network learns for each material of the set: the model's latent (a note where the
+/// model has seen materials the set leaves out) or the fitted attributes.
+fn targets(
+    args: &Args,
+    set: &RenderSet,
+    tables: &std::collections::BTreeMap<String, MerlTable>,
+    device: &deepbrdf_model::burn::tensor::Device,
+    progress: &dyn Progress,
+) -> anyhow::Result<(RecoveryTarget, std::collections::BTreeMap<String, Vec<f32>>)> {
+    if args.target.as_str() != "latent" {
+        return Ok((RecoveryTarget::Attributes, attribute_fits(tables, progress)?));
+    }
+    let model = DeepBrdf::load(&args.model.dir()?, device)?;
+    let seen: Vec<&String> =
+        set.header.excluded.iter().filter(|m| model.provenance().trained_on(m)).collect();
+    if !seen.is_empty() {
+        eprintln!(
+            "note: the model was trained on {} of the materials this set leaves out \
+             (e.g. {}): the autoencoder has seen them",
+            seen.len(),
+            seen[0]
+        );
+    }
+    let target = RecoveryTarget::Latent { model_id: model.id().into(), k: model.k() };
+    Ok((target, latents(&model, tables)?))
+}
+
+/// The training loop's settings: the preset's, with the seed, epochs and checkpoint interval
+/// asked.
+fn loop_settings(args: &Args) -> LoopConfig {
+    let mut settings = args.preset.loop_config().with_seed(args.seed);
+    if let Some(e) = args.epochs {
+        settings = settings.with_epochs(e);
+    }
+    if let Some(c) = args.checkpoint_seconds {
+        settings = settings.with_checkpoint_seconds(c);
+    }
+    settings
 }
