@@ -6,7 +6,7 @@ use super::cpu_time::cpu_seconds;
 use crate::args::data::CacheArg;
 use anyhow::Context;
 use deepbrdf_data::dataset::load_material;
-use deepbrdf_data::{Progress, Silent};
+use deepbrdf_data::{MerlTable, Progress, Silent};
 use deepbrdf_render::brdf::{sample_cosine_hemisphere, InterleavedTable, Rgb};
 use deepbrdf_render::geometry::Vec3;
 use deepbrdf_render::{
@@ -88,15 +88,27 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     let threads = rayon::current_num_threads();
     println!("bench render: {name}, {threads} threads (set RAYON_NUM_THREADS to change)");
 
-    // MERL lookups on one thread, at cosine-distributed direction pairs.
+    bench_lookups(&table, args.lookups);
+    let results = bench_renders(&args, &table, threads)?;
+    println!(
+        "tabulated / analytic time in this run: {:.2} (interpolated), {:.2} (nearest); target: 256x256 at 64 spp < 0.5 s on 2 threads",
+        results[0] / results[2],
+        results[1] / results[2]
+    );
+    Ok(())
+}
+
+/// MERL lookups on one thread at `count` cosine-distributed direction pairs, by the renderer's
+/// interleaved table and by the data layer's (interpolated and nearest), printed.
+fn bench_lookups(table: &MerlTable, count: u32) {
     let mut rng = ChaCha8Rng::seed_from_u64(1);
-    let pairs: Vec<([f64; 3], [f64; 3])> = (0..args.lookups)
+    let pairs: Vec<([f64; 3], [f64; 3])> = (0..count)
         .map(|_| {
             let mut dir = || sample_cosine_hemisphere([rng.random(), rng.random()]).to_array();
             (dir(), dir())
         })
         .collect();
-    let fast = InterleavedTable::new(&table);
+    let fast = InterleavedTable::new(table);
     let lookups: [(&str, &dyn Fn([f64; 3], [f64; 3]) -> [f32; 3]); 3] = [
         ("renderer, interleaved, interpolated", &|wi, wo| fast.lookup_interpolated(wi, wo)),
         ("data layer, interpolated", &|wi, wo| table.lookup_interpolated(wi, wo)),
@@ -115,8 +127,12 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
             s / pairs.len() as f64 * 1e9
         );
     }
+}
 
-    // Whole renders: the preview sphere under sun and sky.
+/// Whole renders of the preview sphere under sun and sky, of the table (interpolated and
+/// nearest, with the lookups a render makes) and of an analytic Lambertian + GGX, printed;
+/// returns the three median times.
+fn bench_renders(args: &Args, table: &MerlTable, threads: usize) -> anyhow::Result<Vec<f64>> {
     let scene = SceneConfig::default().build()?;
     let settings = RenderSettings {
         size: args.size,
@@ -125,7 +141,7 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         jitter: true,
         sampler: Sampler::Sobol,
     };
-    let merl = MerlBrdf::new(&table);
+    let merl = MerlBrdf::new(table);
     let analytic = Sum::plastic([0.3, 0.2, 0.1], 0.1, [0.04; 3]);
     let mut results = Vec::new();
     for (label, brdf) in [
@@ -160,10 +176,5 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
             );
         }
     }
-    println!(
-        "tabulated / analytic time in this run: {:.2} (interpolated), {:.2} (nearest); target: 256x256 at 64 spp < 0.5 s on 2 threads",
-        results[0] / results[2],
-        results[1] / results[2]
-    );
-    Ok(())
+    Ok(results)
 }
