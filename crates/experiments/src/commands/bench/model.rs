@@ -48,25 +48,7 @@ fn parse_preset(s: &str) -> Result<Preset, String> {
 pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     let kind = crate::args::device::kind()?;
     let device = crate::args::device::device()?;
-    let mut runs: Vec<(String, TrainConfig)> = match (args.preset, &args.config) {
-        (Some(p), _) => vec![(p.name().to_string(), p.train_config(args.k))],
-        (None, Some(_)) => Vec::new(),
-        (None, None) => {
-            Preset::ALL.iter().map(|p| (p.name().to_string(), p.train_config(args.k))).collect()
-        }
-    };
-    if let Some(path) = &args.config {
-        let config = TrainConfig::from_file(path)?;
-        runs.push(("config".to_string(), config));
-    }
-    if !args.conv.is_empty() {
-        runs = with_conv(runs, &args.conv)?;
-    }
-    if args.update_readme.is_some() && !runs.iter().any(|(name, _)| name == Preset::Slice.name()) {
-        anyhow::bail!(
-            "--update-readme writes the slice preset's decode time: run with --preset slice"
-        );
-    }
+    let runs = networks(&args)?;
     println!("device {kind}, k = {}", args.k);
     let ipca = ipca_decode(args.k, args.decodes)?;
     println!(
@@ -91,13 +73,11 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
             net.median(),
             all.median()
         );
+        let (deep, linear) = (all.median(), ipca.median());
+        let ratio = deep / linear;
         println!(
-            "{:12} decode vs IPCA's at k = {}: {:.4} s vs {:.4} s ({:.2}x, same run)",
-            "",
-            args.k,
-            all.median(),
-            ipca.median(),
-            all.median() / ipca.median()
+            "{:12} decode vs IPCA's at k = {}: {deep:.4} s vs {linear:.4} s ({ratio:.2}x, same run)",
+            "", args.k
         );
         if name == Preset::Slice.name() {
             slice_decode = Some(all.median());
@@ -121,6 +101,32 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         println!("wrote the decode block of {}", readme.display());
     }
     Ok(())
+}
+
+/// The networks timed: the preset asked (or every preset), the configuration file asked, each
+/// with every convolution algorithm asked; refused where `--update-readme` has no slice
+/// network to time.
+fn networks(args: &Args) -> anyhow::Result<Vec<(String, TrainConfig)>> {
+    let mut runs: Vec<(String, TrainConfig)> = match (args.preset, &args.config) {
+        (Some(p), _) => vec![(p.name().to_string(), p.train_config(args.k))],
+        (None, Some(_)) => Vec::new(),
+        (None, None) => {
+            Preset::ALL.iter().map(|p| (p.name().to_string(), p.train_config(args.k))).collect()
+        }
+    };
+    if let Some(path) = &args.config {
+        let config = TrainConfig::from_file(path)?;
+        runs.push(("config".to_string(), config));
+    }
+    if !args.conv.is_empty() {
+        runs = with_conv(runs, &args.conv)?;
+    }
+    if args.update_readme.is_some() && !runs.iter().any(|(name, _)| name == Preset::Slice.name()) {
+        anyhow::bail!(
+            "--update-readme writes the slice preset's decode time: run with --preset slice"
+        );
+    }
+    Ok(runs)
 }
 
 /// Marker lines of the block `--update-readme` writes.
