@@ -18,7 +18,8 @@ use anyhow::Context;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::{Progress, Silent};
 use deepbrdf_render::{
-    render, Brdf, Image, Lambertian, LightSpec, MerlBrdf, RenderSettings, Sampler, SceneConfig, Sum,
+    render, Brdf, Image, Lambertian, LightSpec, MerlBrdf, RenderSettings, Sampler, Scene,
+    SceneConfig, Sum,
 };
 use std::time::Instant;
 
@@ -139,27 +140,7 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         let scene = SceneConfig { light: spec, ..Default::default() }.build()?;
         for (name, brdf, build) in &brdfs {
             for &sampler in &args.samplers {
-                let mut pairs = Vec::new();
-                let mut seconds = 0.0;
-                let renders = 2.0 * args.pairs as f64;
-                let cpu_start = cpu_seconds();
-                for pair in 0..args.pairs {
-                    let mut one = |seed| -> anyhow::Result<Image> {
-                        let settings = RenderSettings {
-                            size: args.size,
-                            spp: args.spp,
-                            seed,
-                            jitter: true,
-                            sampler,
-                        };
-                        let start = Instant::now();
-                        let image = render(&scene, brdf.as_ref(), &settings, &Silent)?;
-                        seconds += start.elapsed().as_secs_f64() / renders;
-                        Ok(image)
-                    };
-                    pairs.push((one(2 * pair + 1)?, one(2 * pair + 2)?));
-                }
-                let cpu = cpu_start.zip(cpu_seconds()).map(|(a, b)| (b - a) / renders);
+                let (pairs, seconds, cpu) = render_pairs(&args, &scene, brdf.as_ref(), sampler)?;
                 let (noise, top) = relative_noise(&pairs)
                     .with_context(|| format!("{name} under {light}: no covered, lit pixels"))?;
                 let efficiency = |s: f64| format!("{:.1}", 1.0 / (noise * noise * s));
@@ -174,6 +155,33 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// `args.pairs` pairs of renders of `brdf` in `scene` with seeds 2i-1 and 2i, and the mean
+/// wall and CPU seconds per render (CPU where the platform reports it).
+fn render_pairs(
+    args: &Args,
+    scene: &Scene,
+    brdf: &dyn Brdf,
+    sampler: Sampler,
+) -> anyhow::Result<(Vec<(Image, Image)>, f64, Option<f64>)> {
+    let mut pairs = Vec::new();
+    let mut seconds = 0.0;
+    let renders = 2.0 * args.pairs as f64;
+    let cpu_start = cpu_seconds();
+    for pair in 0..args.pairs {
+        let mut one = |seed| -> anyhow::Result<Image> {
+            let settings =
+                RenderSettings { size: args.size, spp: args.spp, seed, jitter: true, sampler };
+            let start = Instant::now();
+            let image = render(scene, brdf, &settings, &Silent)?;
+            seconds += start.elapsed().as_secs_f64() / renders;
+            Ok(image)
+        };
+        pairs.push((one(2 * pair + 1)?, one(2 * pair + 2)?));
+    }
+    let cpu = cpu_start.zip(cpu_seconds()).map(|(a, b)| (b - a) / renders);
+    Ok((pairs, seconds, cpu))
 }
 
 #[cfg(test)]
