@@ -15,14 +15,15 @@ use crate::progress_log::ProgressLog;
 use crate::readme_block;
 use anyhow::{bail, Context};
 use deepbrdf_data::bundled::Collection;
+use deepbrdf_data::dataset::Dataset;
 use deepbrdf_data::files::write_atomic;
 use deepbrdf_data::table_set::{StreamedDataset, TableSet};
 use deepbrdf_data::Progress;
 use deepbrdf_eval::baseline::BaselineMethod;
 use deepbrdf_eval::deep::{DeepMethod, NAME};
 use deepbrdf_eval::figures::slices::{self as slices_figure, FIG2_MATERIAL};
-use deepbrdf_eval::harness::{self, AtKs, HarnessConfig, Materials, Measure, Mode};
-use deepbrdf_eval::robustness;
+use deepbrdf_eval::harness::{self, AtKs, HarnessConfig, Materials, Measure, Mode, Results};
+use deepbrdf_eval::robustness::{self, Robustness};
 use deepbrdf_eval::saved_sweep::SavedSweep;
 use deepbrdf_eval::sweep_report::{minutes, training_csv, SweepReport};
 use deepbrdf_model::{Preset, TrainConfig};
@@ -161,6 +162,41 @@ impl Args {
 
     /// The training materials, their tables streamed from the table cache (or their files)
     /// where they can be: the sweep reads each table when it needs it.
+    /// The DeepBRDF models held in memory for Fig. 2 (at `fig2_ks`): none in k-fold mode, where
+    /// the models of earlier folds are loaded again when the robustness step needs them.
+    fn retained<'a>(&self, fig2_ks: &'a [usize]) -> &'a [usize] {
+        match self.mode {
+            Mode::KFold { .. } => &[],
+            _ => fig2_ks,
+        }
+    }
+
+    /// The harness' settings, checked (with `--eval-collections` only in generalize mode).
+    fn harness_config(&self) -> anyhow::Result<HarnessConfig> {
+        if self.mode != Mode::Generalize && self.eval_collections.is_some() {
+            bail!("--eval-collections is for generalize mode only");
+        }
+        let config = HarnessConfig {
+            ks: self.ks.clone(),
+            mode: self.mode,
+            seed: self.seed,
+            measures: self.measures.clone(),
+            only_fold: None,
+        };
+        config.validate()?;
+        Ok(config)
+    }
+
+    /// Generalize mode's evaluation collections (the real RGL measurements by default).
+    fn load_eval(&self, progress: &dyn Progress) -> anyhow::Result<Option<Dataset>> {
+        if self.mode != Mode::Generalize {
+            return Ok(None);
+        }
+        let collections =
+            self.eval_collections.clone().unwrap_or_else(|| vec![Collection::RglMeasured]);
+        Ok(Some(crate::args::data::load_collections(&collections, &self.data, progress)?))
+    }
+
     fn load_data(&self, progress: &dyn Progress) -> anyhow::Result<StreamedDataset> {
         let mut data = self.data.load_streamed(progress)?;
         if let Some(n) = self.limit {
@@ -181,17 +217,7 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
     let started = Instant::now();
     let logged = ProgressLog::new(bars, quiet, Duration::from_secs(30));
     let progress: &dyn Progress = &logged;
-    if args.mode != Mode::Generalize && args.eval_collections.is_some() {
-        bail!("--eval-collections is for generalize mode only");
-    }
-    let harness_config = HarnessConfig {
-        ks: args.ks.clone(),
-        mode: args.mode,
-        seed: args.seed,
-        measures: args.measures.clone(),
-        only_fold: None,
-    };
-    harness_config.validate()?;
+    let harness_config = args.harness_config()?;
     let config_for = args.config_for()?;
     let deep_ks = args.deep_ks()?;
     let fig2_ks = args.fig2_ks()?;
@@ -203,14 +229,7 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
     let models_dir = out.join("models");
 
     let data = args.load_data(progress)?;
-    let eval = match args.mode {
-        Mode::Generalize => {
-            let collections =
-                args.eval_collections.clone().unwrap_or_else(|| vec![Collection::RglMeasured]);
-            Some(crate::args::data::load_collections(&collections, &args.data, progress)?)
-        }
-        _ => None,
-    };
+    let eval = args.load_eval(progress)?;
     let loaded_at = started.elapsed().as_secs_f64();
     let training = training_label(&args, &config_for(deep_ks[0]), &kind.to_string());
     println!(
@@ -223,14 +242,8 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
     );
 
     let (pca, ipca) = (BaselineMethod::pca(), BaselineMethod::ipca());
-    // In k-fold mode the models of earlier folds are loaded again when the robustness step
-    // needs them, rather than held in memory.
-    let retained = match args.mode {
-        Mode::KFold { .. } => Vec::new(),
-        _ => fig2_ks.clone(),
-    };
     let deep = DeepMethod::new(config_for, &models_dir, &data.label, device.clone())
-        .retaining(&retained)
+        .retaining(args.retained(&fig2_ks))
         .refining(args.refine.refinement()?);
     let materials = Materials { names: &data.names, tables: data.tables(), label: &data.label };
     let eval_label = eval.as_ref().map(|e| format!("{} ({} materials)", e.label, e.len()));
@@ -254,12 +267,8 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
         Some(e) => (&e.names, &e.tables),
         None => (&data.names, data.tables()),
     };
-    let folds = args.mode.folds(data.names.len(), scored.0.len(), args.seed)?;
-    let robustness =
-        robustness::measure(scored.0, scored.1, &folds, &deep, &fig2_ks, &results, progress)?;
-    robustness.write(&out)?;
-
-    let fig2 = fig2_picture(&args, fig2_ks[0], scored, &folds, &deep, &out)?;
+    let fig2 = Fig2 { ks: &fig2_ks, deep: &deep, out: &out };
+    let (robustness, fig2) = fig2.measure(&args, scored, data.names.len(), &results, progress)?;
     let fits = deep.fits();
     write_atomic(&out.join("training.csv"), training_csv(&fits).as_bytes())?;
 
@@ -330,6 +339,33 @@ pub fn saved_block(
 
 /// The Fig. 2 picture for `--fig2-material` (skipped with a note when it is not in the data),
 /// at `k` (the first of the Fig. 2 k), by the model of the fold that evaluates it.
+/// Fig. 2: the DeepBRDF models' errors from reduced inputs at `ks` (the first also drawn).
+struct Fig2<'a> {
+    ks: &'a [usize],
+    deep: &'a DeepMethod,
+    out: &'a Path,
+}
+
+impl Fig2<'_> {
+    /// The robustness table over `scored` (written to the output) and the picture's file, if
+    /// its material is scored; `trained` materials in the training set.
+    fn measure(
+        &self,
+        args: &Args,
+        scored: (&[String], &dyn TableSet),
+        trained: usize,
+        results: &Results,
+        progress: &dyn Progress,
+    ) -> anyhow::Result<(Robustness, Option<String>)> {
+        let folds = args.mode.folds(trained, scored.0.len(), args.seed)?;
+        let robustness =
+            robustness::measure(scored.0, scored.1, &folds, self.deep, self.ks, results, progress)?;
+        robustness.write(self.out)?;
+        let picture = fig2_picture(args, self.ks[0], scored, &folds, self.deep, self.out)?;
+        Ok((robustness, picture))
+    }
+}
+
 fn fig2_picture(
     args: &Args,
     k: usize,
