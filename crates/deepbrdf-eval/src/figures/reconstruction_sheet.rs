@@ -43,6 +43,16 @@ pub struct ReconstructionSheet {
     pub columns: Vec<Column>,
 }
 
+/// A reconstruction's caption naming its method and image RelAE (Figs. 4, 8 and 9).
+pub fn relae_caption(label: &str, _k: usize, relae: f64) -> String {
+    format!("{label}: RelAE {relae:.3}")
+}
+
+/// A reconstruction's caption naming its method, k and image RelAE (Fig. 6).
+pub fn relae_caption_with_k(label: &str, k: usize, relae: f64) -> String {
+    format!("{label} {k}D: RelAE {relae:.3}")
+}
+
 /// The sheet's layout for `columns` tiles a row: captions larger than the default, for
 /// 256-px tiles.
 pub fn sheet_config(columns: u32) -> SheetConfig {

@@ -20,6 +20,7 @@ use deepbrdf_data::dataset::{DataSource, Dataset};
 use deepbrdf_data::files::write_atomic;
 use deepbrdf_data::{MerlTable, Progress};
 use deepbrdf_eval::baseline::BaselineMethod;
+use deepbrdf_eval::figures::reconstruction_sheet::relae_caption;
 use deepbrdf_eval::figures::{ReconstructionSheet, SheetInput};
 use deepbrdf_eval::harness::{Codec, Method};
 use deepbrdf_eval::metrics::ImageRelaeConfig;
@@ -279,14 +280,13 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let names: Vec<&str> = shown.names.iter().map(|n| n.rsplit('/').next().unwrap_or(n)).collect();
     let tables: Vec<&MerlTable> = shown.tables.iter().collect();
     let methods: [(&str, &dyn Codec); 2] = [("DeepBRDF", &deep), (label, baseline.as_ref())];
-    let caption = |label: &str, _k: usize, e: f64| format!("{label}: RelAE {e:.3}");
     let input = SheetInput {
         names: &names,
         tables: &tables,
         methods: &methods,
         config: &config,
         background: [0, 0, 0],
-        caption: &caption,
+        caption: &relae_caption,
     };
     let sheet =
         ReconstructionSheet::measure(&input, progress).with_context(|| format!("Fig. {figure}"))?;

@@ -11,6 +11,7 @@ use anyhow::{bail, Context};
 use deepbrdf_data::dataset::{DataSource, Dataset};
 use deepbrdf_data::files::write_atomic;
 use deepbrdf_data::{MerlTable, Progress};
+use deepbrdf_eval::figures::reconstruction_sheet::relae_caption;
 use deepbrdf_eval::figures::{ReconstructionSheet, SheetInput};
 use deepbrdf_eval::harness::Codec;
 use deepbrdf_eval::metrics::ImageRelaeConfig;
@@ -90,14 +91,13 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         .collect();
     let names: Vec<&str> = data.names.iter().map(String::as_str).collect();
     let tables: Vec<&MerlTable> = data.tables.iter().collect();
-    let caption = |label: &str, _k: usize, e: f64| format!("{label}: RelAE {e:.3}");
     let input = SheetInput {
         names: &names,
         tables: &tables,
         methods: &methods,
         config: &config,
         background: [0, 0, 0],
-        caption: &caption,
+        caption: &relae_caption,
     };
     let sheet = ReconstructionSheet::measure(&input, progress).context("Fig. 4")?;
     std::fs::create_dir_all(&args.out)

@@ -21,7 +21,7 @@ use deepbrdf_data::files::write_atomic;
 use deepbrdf_data::{MerlTable, Progress, Silent};
 use deepbrdf_eval::baseline::{BaselineCodec, BaselineMethod};
 use deepbrdf_eval::figures::latent_map::{THUMB_SIZE, THUMB_SPP};
-use deepbrdf_eval::figures::reconstruction_sheet::sheet_config;
+use deepbrdf_eval::figures::reconstruction_sheet::{relae_caption_with_k, sheet_config};
 use deepbrdf_eval::figures::{LatentMap, LatentMapInput, ReconstructionSheet, SheetInput};
 use deepbrdf_eval::harness::{Codec, Method as _};
 use deepbrdf_eval::metrics::ImageRelaeConfig;
@@ -157,14 +157,13 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let methods: Vec<(&str, &dyn Codec)> =
         codecs.iter().map(|(label, codec)| (label.as_str(), codec.as_ref())).collect();
     let background = sheet_config(0).background;
-    let caption = |label: &str, k: usize, e: f64| format!("{label} {k}D: RelAE {e:.3}");
     let input = SheetInput {
         names: &names,
         tables: &tables,
         methods: &methods,
         config: &config,
         background,
-        caption: &caption,
+        caption: &relae_caption_with_k,
     };
     let sheet = ReconstructionSheet::measure(&input, progress).context("Fig. 6")?;
     let rows: Vec<usize> = (0..names.len()).collect();
