@@ -127,30 +127,7 @@ fn texts(
     let noise = &sheet.noise;
 
     let labels: Vec<&str> = models.iter().map(|(_, l)| l.as_str()).collect();
-    let mut csv = format!(
-        "material,shown,render_noise,{}\n",
-        labels.iter().map(|l| format!("relae_{}", l.to_lowercase())).collect::<Vec<_>>().join(",")
-    );
-    let mut table = format!(
-        "| material | render noise | {} |\n| --- | ---: |{}\n",
-        labels.join(" | "),
-        " ---: |".repeat(models.len())
-    );
-    for (i, name) in data.names.iter().enumerate() {
-        write!(csv, "{name},{},{:.6}", shown.contains(&i), noise[i])?;
-        write!(
-            table,
-            "| {name}{} | {:.4} |",
-            if shown.contains(&i) { " (shown)" } else { "" },
-            noise[i]
-        )?;
-        for e in &errors {
-            write!(csv, ",{:.6}", e[i])?;
-            write!(table, " {:.4} |", e[i])?;
-        }
-        csv.push('\n');
-        table.push('\n');
-    }
+    let (csv, mut table) = per_material(&labels, &data.names, shown, noise, &errors)?;
     let means: Vec<f64> = errors.iter().map(|e| finite_mean(e.iter().copied())).collect();
     writeln!(
         table,
@@ -197,6 +174,42 @@ fn texts(
         seed2 = config.next_seed().render.seed,
     );
     Ok((csv, md))
+}
+
+/// Per material, its render noise and each model's image RelAE (`errors[m][i]`), as the
+/// figure's CSV and the summary's table (without its mean row).
+fn per_material(
+    labels: &[&str],
+    names: &[String],
+    shown: &[usize],
+    noise: &[f64],
+    errors: &[&Vec<f64>],
+) -> anyhow::Result<(String, String)> {
+    let mut csv = format!(
+        "material,shown,render_noise,{}\n",
+        labels.iter().map(|l| format!("relae_{}", l.to_lowercase())).collect::<Vec<_>>().join(",")
+    );
+    let mut table = format!(
+        "| material | render noise | {} |\n| --- | ---: |{}\n",
+        labels.join(" | "),
+        " ---: |".repeat(labels.len())
+    );
+    for (i, name) in names.iter().enumerate() {
+        write!(csv, "{name},{},{:.6}", shown.contains(&i), noise[i])?;
+        write!(
+            table,
+            "| {name}{} | {:.4} |",
+            if shown.contains(&i) { " (shown)" } else { "" },
+            noise[i]
+        )?;
+        for e in errors {
+            write!(csv, ",{:.6}", e[i])?;
+            write!(table, " {:.4} |", e[i])?;
+        }
+        csv.push('\n');
+        table.push('\n');
+    }
+    Ok((csv, table))
 }
 
 #[cfg(test)]
