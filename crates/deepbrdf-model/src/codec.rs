@@ -13,7 +13,7 @@ use deepbrdf_data::merl::N_PHI_D;
 use deepbrdf_data::network_input::mapped_layout;
 use deepbrdf_data::MerlTable;
 
-use crate::artifact::{ModelArtifact, Provenance};
+use crate::autoencoder::artifact::{ModelArtifact, Provenance};
 use crate::autoencoder::{
     Autoencoder, AutoencoderConfig, INPUT_CHANNELS, INPUT_SIDE, INPUT_VALUES,
 };
@@ -224,7 +224,7 @@ impl DeepBrdf {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::artifact::Provenance;
+    use crate::autoencoder::artifact::Provenance;
     use crate::device::DeviceKind;
     use deepbrdf_data::merl::{read_merl, write_merl, CELLS, VALUES};
 

@@ -8,7 +8,7 @@ use burn::prelude::*;
 use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::{MerlTable, Progress};
 
-use crate::artifact::{ModelArtifact, MODEL_DIR};
+use crate::autoencoder::artifact::{ModelArtifact, MODEL_DIR};
 use crate::autoencoder::train::{train_within, TrainConfig};
 use crate::codec::DeepBrdf;
 use crate::error::Result;

@@ -7,14 +7,14 @@
 //! - [`train`]: one training loop for every network (schedule, seeded batches, checkpoints
 //!   that resume exactly, NaN stop, CSV log), and the autoencoder's training through it, each
 //!   family with its own step; [`training_set`]: the mapped layouts it trains on.
-//! - [`artifact`]: the self-contained saved model; [`codec`]: encode / decode with it.
+//! - [`autoencoder::artifact`]: the self-contained saved model, in the one container every
+//!   saved network shares (manifest, id, parts' checksums, atomic writes); [`codec`]: encode /
+//!   decode with it.
 //! - [`fit`]: all of the above on a set of MERL tables.
 //! - [`recovery`]: single-image recovery (§5.2): the CNN from a photo to the latent, Fig. 15.
-pub mod artifact;
-mod atomic;
+mod artifact;
 pub mod autoencoder;
 pub mod codec;
-mod container;
 pub mod device;
 pub mod error;
 pub mod fit;
@@ -32,7 +32,7 @@ pub mod timing;
 pub mod train;
 pub mod training_set;
 
-pub use artifact::{ModelArtifact, Provenance};
+pub use autoencoder::artifact::{ModelArtifact, Provenance};
 pub use autoencoder::slice::{augmentation, refine};
 pub use autoencoder::train::{train, train_within, SliceDropoutConfig, TrainConfig, Trained};
 pub use autoencoder::{Autoencoder, AutoencoderConfig};

@@ -12,7 +12,7 @@ use deepbrdf_data::merl::VALUES;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::artifact::{ModelArtifact, Provenance};
+use crate::autoencoder::artifact::{ModelArtifact, Provenance};
 use crate::autoencoder::convolutional::step::gradients;
 use crate::autoencoder::AutoencoderConfig;
 use crate::codec::DeepBrdf;

@@ -12,7 +12,7 @@ use crate::error::{EvalError, Result};
 use crate::harness::{Codec, FoldTraining, Method};
 use deepbrdf_data::mapping::MedianReference;
 use deepbrdf_data::{MerlTable, Progress};
-use deepbrdf_model::artifact::MODEL_DIR;
+use deepbrdf_model::autoencoder::artifact::MODEL_DIR;
 use deepbrdf_model::burn::tensor::Device;
 use deepbrdf_model::refine::Refinement;
 use deepbrdf_model::train::json_close;

@@ -11,7 +11,10 @@
 //! - [`Autoencoder::Slice`] ([`slice`]): the `slice` preset
 //!   ([`AutoencoderConfig::slice`]): one basis for the images of all phi_d slices, a decoder
 //!   MLP shared by the slices; small enough to ship.
+//!
+//! [`artifact`]: the trained network saved with its median reference and provenance.
 
+pub mod artifact;
 mod config;
 pub mod convolutional;
 mod init;

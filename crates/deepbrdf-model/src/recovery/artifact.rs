@@ -1,6 +1,6 @@
-//! The saved recovery CNN, as `artifact.rs` saves DeepBRDF models: a directory with a manifest
-//! whose id covers the configuration, what the network predicts, its provenance and the
-//! checksum of its weights.
+//! The saved recovery CNN, in the container every saved network shares ([`crate::artifact`]):
+//! a directory with a manifest whose id covers the configuration, what the network predicts,
+//! its provenance and the checksum of its weights.
 //!
 //! ```text
 //! recovery/
@@ -12,27 +12,26 @@
 //! A network for one DeepBRDF model is refused for another ([`RecoveryArtifact::check_model`]):
 //! its outputs mean nothing in another model's latent space.
 
+use std::ops::RangeInclusive;
 use std::path::{Path, PathBuf};
 
 use burn::prelude::*;
 use burn::tensor::TensorData;
 use serde::{Deserialize, Serialize};
-use sha2::{Digest, Sha256};
 
 use super::network::{RecoveryConfig, RecoveryNet};
 use super::step::RecoveryTrained;
-use crate::artifact::{canonical, load_weights, part_of, save_dir, Part};
-use crate::atomic::{check_format, read_limited, read_weights, write_manifest, write_weights};
+use crate::artifact::files::{read_limited, read_weights, write_manifest, write_weights};
+use crate::artifact::Manifest as _;
+use crate::artifact::{check_id, dir, load_weights, network_bytes, parse_manifest, Part};
 use crate::error::{ModelError, Result};
 
 /// File name of the manifest.
 pub const RECOVERY_MANIFEST: &str = "recovery.json";
-/// File name of the weights (the model's, [`crate::artifact::WEIGHTS_FILE`]).
-pub const RECOVERY_WEIGHTS: &str = crate::artifact::WEIGHTS_FILE;
+/// File name of the weights (the model's, [`crate::autoencoder::artifact::WEIGHTS_FILE`]).
+pub const RECOVERY_WEIGHTS: &str = crate::autoencoder::artifact::WEIGHTS_FILE;
 /// Name of the recovery network's directory beside a model (`models/default/recovery`).
 pub const RECOVERY_DIR: &str = "recovery";
-const FORMAT: &str = "deepbrdf-recovery";
-const VERSION: u32 = 1;
 
 /// What the network's outputs are.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -87,17 +86,37 @@ struct Manifest {
     weights: Part,
 }
 
+impl crate::artifact::Manifest for Manifest {
+    const FORMAT: &'static str = "deepbrdf-recovery";
+    const VERSIONS: RangeInclusive<u32> = 1..=1;
+    const WHAT: &'static str = "a recovery network";
+
+    fn format(&self) -> (&str, u32) {
+        (&self.format, self.version)
+    }
+
+    fn id(&self) -> &str {
+        &self.id
+    }
+
+    fn content(&self) -> serde_json::Value {
+        serde_json::json!({
+            "config": self.config,
+            "target": self.target,
+            "mean": self.mean,
+            "scale": self.scale,
+            "provenance": self.provenance,
+            "weights": self.weights,
+        })
+    }
+}
+
 /// A trained recovery network in memory.
 #[derive(Debug, Clone)]
 pub struct RecoveryArtifact {
     config: RecoveryConfig,
-    target: RecoveryTarget,
-    mean: Vec<f32>,
-    scale: Vec<f32>,
-    provenance: RecoveryProvenance,
+    manifest: Manifest,
     weights: Vec<u8>,
-    part: Part,
-    id: String,
 }
 
 impl RecoveryArtifact {
@@ -115,32 +134,25 @@ impl RecoveryArtifact {
                 target.outputs()
             )));
         }
-        let weights = trained
-            .model
-            .clone()
-            .into_record()
-            .into_bytes()
-            .map_err(|e| ModelError::Invalid(format!("cannot serialise the weights: {e}")))?
-            .to_vec();
-        let weights = crate::record::rewrite(weights, false, |name| name)
-            .map_err(|e| ModelError::Invalid(format!("cannot serialise the weights: {e}")))?;
-        let part = part_of(&weights, RECOVERY_WEIGHTS);
-        let mut artifact = Self {
-            config,
+        let weights = network_bytes(trained.model.clone())?;
+        let mut manifest = Manifest {
+            format: <Manifest as crate::artifact::Manifest>::FORMAT.into(),
+            version: 1,
+            id: String::new(),
+            config: serde_json::to_value(&config)
+                .map_err(|e| ModelError::Invalid(format!("cannot serialise: {e}")))?,
             target,
             mean: trained.mean.clone(),
             scale: trained.scale.clone(),
             provenance,
-            weights,
-            part,
-            id: String::new(),
+            weights: Part::of(&weights, RECOVERY_WEIGHTS),
         };
-        artifact.id = artifact.manifest_id()?;
-        Ok(artifact)
+        manifest.id = manifest.computed_id();
+        Ok(Self { config, manifest, weights })
     }
 
     pub fn id(&self) -> &str {
-        &self.id
+        &self.manifest.id
     }
 
     pub fn config(&self) -> &RecoveryConfig {
@@ -148,16 +160,16 @@ impl RecoveryArtifact {
     }
 
     pub fn target(&self) -> &RecoveryTarget {
-        &self.target
+        &self.manifest.target
     }
 
     pub fn provenance(&self) -> &RecoveryProvenance {
-        &self.provenance
+        &self.manifest.provenance
     }
 
     /// Errors unless this network predicts the latent of the DeepBRDF model `model_id`.
     pub fn check_model(&self, model_id: &str) -> Result<()> {
-        match &self.target {
+        match &self.manifest.target {
             RecoveryTarget::Latent { model_id: own, .. } if own == model_id => Ok(()),
             RecoveryTarget::Latent { model_id: own, .. } => Err(ModelError::Invalid(format!(
                 "this recovery network predicts the latent of DeepBRDF model {own}, not of model \
@@ -170,21 +182,6 @@ impl RecoveryArtifact {
         }
     }
 
-    fn manifest_id(&self) -> Result<String> {
-        let config = serde_json::to_value(&self.config)
-            .map_err(|e| ModelError::Invalid(format!("cannot serialise the configuration: {e}")))?;
-        let content = serde_json::json!({
-            "config": config,
-            "target": self.target,
-            "mean": self.mean,
-            "scale": self.scale,
-            "provenance": self.provenance,
-            "weights": self.part,
-        });
-        let digest = Sha256::digest(canonical(content).to_string().as_bytes());
-        Ok(hex::encode(&digest[..16]))
-    }
-
     /// The network on `device` (inference) with its standardisation.
     pub fn predictor(&self, device: &Device) -> Result<Predictor> {
         let device = device.clone().without_autodiff();
@@ -193,8 +190,8 @@ impl RecoveryArtifact {
         Ok(Predictor {
             net,
             side: self.config.input_side,
-            mean: self.mean.clone(),
-            scale: self.scale.clone(),
+            mean: self.manifest.mean.clone(),
+            scale: self.manifest.scale.clone(),
             device,
         })
     }
@@ -202,24 +199,10 @@ impl RecoveryArtifact {
     /// Writes the directory `dir` (beside it, then renamed into place); an existing `dir` is
     /// replaced only if it is itself a recovery network.
     pub fn save(&self, dir: &Path) -> Result<()> {
-        save_dir(dir, RECOVERY_MANIFEST, "a recovery network", |tmp| self.write_parts(tmp))
-    }
-
-    fn write_parts(&self, dir: &Path) -> Result<()> {
-        write_weights(&dir.join(RECOVERY_WEIGHTS), &self.weights)?;
-        let manifest = Manifest {
-            format: FORMAT.into(),
-            version: VERSION,
-            id: self.id.clone(),
-            config: serde_json::to_value(&self.config)
-                .map_err(|e| ModelError::Invalid(format!("cannot serialise: {e}")))?,
-            target: self.target.clone(),
-            mean: self.mean.clone(),
-            scale: self.scale.clone(),
-            provenance: self.provenance.clone(),
-            weights: self.part.clone(),
-        };
-        write_manifest(&dir.join(RECOVERY_MANIFEST), &manifest)
+        dir::save(dir, RECOVERY_MANIFEST, "a recovery network", |tmp| {
+            write_weights(&tmp.join(RECOVERY_WEIGHTS), &self.weights)?;
+            write_manifest(&tmp.join(RECOVERY_MANIFEST), &self.manifest)
+        })
     }
 
     /// Loads a recovery network directory (or the `recovery/` inside a model directory),
@@ -228,15 +211,7 @@ impl RecoveryArtifact {
         let dir = resolve(path)?;
         let manifest_path = dir.join(RECOVERY_MANIFEST);
         let text = read_limited(&manifest_path, 16 << 20)?;
-        let manifest: Manifest = serde_json::from_slice(&text).map_err(|e| {
-            ModelError::format(&manifest_path, format!("not a recovery network manifest: {e}"))
-        })?;
-        check_format(
-            &manifest_path,
-            (&manifest.format, manifest.version),
-            FORMAT,
-            VERSION..=VERSION,
-        )?;
+        let manifest: Manifest = parse_manifest(&manifest_path, &text)?;
         let config: RecoveryConfig =
             serde_json::from_value(manifest.config.clone()).map_err(|e| {
                 ModelError::format(&manifest_path, format!("bad network configuration: {e}"))
@@ -251,43 +226,16 @@ impl RecoveryArtifact {
         }
         let weights_path = dir.join(RECOVERY_WEIGHTS);
         let weights = read_weights(&weights_path, 1 << 30)?;
-        if part_of(&weights, RECOVERY_WEIGHTS) != manifest.weights {
-            return Err(ModelError::mismatch(
-                &weights_path,
-                format!(
-                    "these weights do not belong to recovery network {} (checksum differs)",
-                    manifest.id
-                ),
-            ));
-        }
-        let artifact = Self {
-            config,
-            target: manifest.target,
-            mean: manifest.mean,
-            scale: manifest.scale,
-            provenance: manifest.provenance,
-            weights,
-            part: manifest.weights,
-            id: manifest.id.clone(),
-        };
-        if artifact.manifest_id()? != manifest.id {
-            return Err(ModelError::mismatch(
-                &manifest_path,
-                "the manifest was edited or damaged (its id does not match its content)",
-            ));
-        }
-        Ok(artifact)
+        let owner = format!("recovery network {}", manifest.id);
+        manifest.weights.check(&weights_path, &weights, "these weights", &owner)?;
+        check_id(&manifest_path, &manifest)?;
+        Ok(Self { config, manifest, weights })
     }
 }
 
 /// `path` if it holds a recovery manifest, else `path/recovery` if that does.
 fn resolve(path: &Path) -> Result<PathBuf> {
-    crate::artifact::resolve_artifact_dir(
-        path,
-        RECOVERY_MANIFEST,
-        RECOVERY_DIR,
-        "a recovery network",
-    )
+    dir::resolve(path, RECOVERY_MANIFEST, RECOVERY_DIR, "a recovery network")
 }
 
 /// A loaded recovery network: prepared images in, targets out.

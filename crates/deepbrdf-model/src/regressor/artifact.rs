@@ -1,28 +1,28 @@
-//! The saved regressor: one checksummed file ([`crate::container::Container`], written
-//! atomically) holding a JSON manifest and the network's weights (burnpack). The manifest names
+//! The saved regressor, in the container every saved network shares ([`crate::artifact`]): one
+//! checksummed file of sections ([`crate::artifact::sections::Container`], written atomically)
+//! holding a JSON manifest and the network's weights (burnpack). The manifest names
 //! the representation the outputs belong to ([`Target`]: a DeepBRDF model's id, or an IPCA
 //! basis's digest, and k), the network's shape, the normalisation of inputs and targets
 //! ([`Scaling`]) and how it was trained; its id is a SHA-256 over all of that and the weights.
 //! Loading it for another model is refused ([`Regressor::load_for`]).
 
 use std::fmt;
+use std::ops::RangeInclusive;
 use std::path::Path;
 
 use burn::prelude::*;
 use burn::tensor::TensorData;
 use serde::{Deserialize, Serialize};
-use sha2::{Digest, Sha256};
 
 use super::network::{NetworkShape, RegressorNet, ATTRIBUTES};
 use super::scaling::{features, Scaling};
-use crate::atomic::check_format;
-use crate::container::Container;
+use crate::artifact::sections::Container;
+use crate::artifact::Manifest as _;
+use crate::artifact::{check_id, load_weights, network_bytes, parse_manifest, sha256_hex};
 use crate::error::{ModelError, Result};
 
 /// The container kind tag of a regressor file.
 pub const REGRESSOR_KIND: &[u8; 8] = b"REGRESS1";
-const FORMAT: &str = "deepbrdf-regressor";
-const VERSION: u32 = 1;
 
 /// What the regressor's outputs are.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -91,13 +91,24 @@ struct Manifest {
     weights_sha256: String,
 }
 
-impl Manifest {
-    /// SHA-256 over everything but the id.
-    fn digest(&self) -> String {
+impl crate::artifact::Manifest for Manifest {
+    const FORMAT: &'static str = "deepbrdf-regressor";
+    const VERSIONS: RangeInclusive<u32> = 1..=1;
+    const WHAT: &'static str = "a regressor";
+
+    fn format(&self) -> (&str, u32) {
+        (&self.format, self.version)
+    }
+
+    fn id(&self) -> &str {
+        &self.id
+    }
+
+    /// Everything but the id (the id's own field set to null).
+    fn content(&self) -> serde_json::Value {
         let mut content = serde_json::to_value(self).unwrap_or_default();
         content["id"] = serde_json::Value::Null;
-        let text = crate::artifact::canonical(content).to_string();
-        hex::encode(&Sha256::digest(text.as_bytes())[..16])
+        content
     }
 }
 
@@ -121,32 +132,24 @@ impl Regressor {
         device: &Device,
     ) -> Result<Self> {
         scaling.validate(target.k)?;
-        let bytes = net
-            .clone()
-            .into_record()
-            .into_bytes()
-            .map_err(|e| ModelError::Invalid(format!("cannot serialise the weights: {e}")))?
-            .to_vec();
-        // Without Burn's random parameter ids: the same network has the same bytes.
-        let weights = crate::record::rewrite(bytes, false, |name| name)
-            .map_err(|e| ModelError::Invalid(format!("cannot serialise the weights: {e}")))?;
+        let weights = network_bytes(net.clone())?;
         let mut manifest = Manifest {
-            format: FORMAT.into(),
-            version: VERSION,
+            format: <Manifest as crate::artifact::Manifest>::FORMAT.into(),
+            version: 1,
             id: String::new(),
             target,
             shape,
             scaling,
             provenance,
-            weights_sha256: hex::encode(Sha256::digest(&weights)),
+            weights_sha256: sha256_hex(&weights),
         };
-        manifest.id = manifest.digest();
+        manifest.id = manifest.computed_id();
         Ok(Self { manifest, weights, net, device: device.clone().without_autodiff() })
     }
 
     pub(super) fn set_train_error(&mut self, error: f64) -> Result<()> {
         self.manifest.provenance.train_relative_error = error;
-        self.manifest.id = self.manifest.digest();
+        self.manifest.id = self.manifest.computed_id();
         Ok(())
     }
 
@@ -209,16 +212,9 @@ impl Regressor {
         let bad = |problem: String| ModelError::format(path, problem);
         let json = c.take("manifest").ok_or_else(|| bad("no manifest section".into()))?;
         let weights = c.take("weights").ok_or_else(|| bad("no weights section".into()))?;
-        let manifest: Manifest = serde_json::from_slice(&json)
-            .map_err(|e| bad(format!("not a regressor manifest: {e}")))?;
-        check_format(path, (&manifest.format, manifest.version), FORMAT, VERSION..=VERSION)?;
-        if manifest.digest() != manifest.id {
-            return Err(ModelError::mismatch(
-                path,
-                "the manifest was edited or damaged (its id does not match its content)",
-            ));
-        }
-        if hex::encode(Sha256::digest(&weights)) != manifest.weights_sha256 {
+        let manifest: Manifest = parse_manifest(path, &json)?;
+        check_id(path, &manifest)?;
+        if sha256_hex(&weights) != manifest.weights_sha256 {
             return Err(ModelError::mismatch(path, "the weights do not belong to the manifest"));
         }
         let shape = manifest.shape;
@@ -228,11 +224,7 @@ impl Regressor {
         manifest.scaling.validate(manifest.target.k).map_err(|e| bad(e.to_string()))?;
         let device = device.clone().without_autodiff();
         let skeleton = crate::seeded::exclusive(|| RegressorNet::init(&shape, &device));
-        let record = crate::record::float_record(weights.clone())
-            .map_err(|e| bad(format!("bad weights: {e}")))?;
-        let net = skeleton
-            .try_load_record(record)
-            .map_err(|e| bad(format!("the weights do not fit the network: {e}")))?;
+        let net = load_weights(skeleton, weights.clone()).map_err(|e| bad(e.to_string()))?;
         Ok(Self { manifest, weights, net, device })
     }
 

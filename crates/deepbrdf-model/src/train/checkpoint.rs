@@ -12,7 +12,7 @@ use burn::tensor::Bytes;
 use serde::{Deserialize, Serialize};
 
 use super::log::EpochRecord;
-use crate::container::Container;
+use crate::artifact::sections::Container;
 use crate::error::{ModelError, Result};
 
 /// File name of the checkpoint inside a training directory.

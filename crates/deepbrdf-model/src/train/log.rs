@@ -7,7 +7,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::atomic::write_atomic;
+use crate::artifact::files::write_atomic;
 
 /// File name of the per-epoch CSV log inside a training directory.
 pub const LOG_FILE: &str = "train_log.csv";

@@ -23,7 +23,7 @@ use super::divergence::check_finite;
 use super::log::{write_log, EpochRecord, LOG_FILE};
 use super::order::{batch_of, batches_per_epoch, epoch_order};
 use super::progress::RunProgress;
-use crate::atomic::write_atomic;
+use crate::artifact::files::write_atomic;
 use crate::error::{ModelError, Result};
 
 /// What a network brings to the loop: how to build it and the loss and gradients of a batch.

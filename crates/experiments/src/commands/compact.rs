@@ -37,7 +37,7 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
 /// Compacts `path`; returns its bytes before and after.
 fn compact_path(path: &Path) -> anyhow::Result<(u64, u64)> {
     if path.is_dir() {
-        if path.join(deepbrdf_model::artifact::MANIFEST_FILE).is_file() {
+        if path.join(deepbrdf_model::autoencoder::artifact::MANIFEST_FILE).is_file() {
             return resave(
                 path,
                 |dir| {

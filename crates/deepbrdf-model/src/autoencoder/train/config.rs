@@ -10,7 +10,7 @@ use burn::prelude::*;
 use deepbrdf_data::augment::SliceSelection;
 
 use super::batch::SliceDropout;
-use crate::atomic::read_limited;
+use crate::artifact::files::read_limited;
 use crate::autoencoder::{Autoencoder, AutoencoderConfig};
 use crate::error::ModelError;
 use crate::loss::LossNorm;

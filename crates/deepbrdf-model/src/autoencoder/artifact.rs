@@ -1,5 +1,6 @@
-//! The self-contained model artifact: a directory holding everything needed to use a trained
-//! DeepBRDF network, with checksums that tie the parts together.
+//! The saved DeepBRDF model: a directory holding everything needed to use a trained autoencoder,
+//! in the container every saved network shares ([`crate::artifact`]), with checksums that tie
+//! the parts together.
 //!
 //! ```text
 //! model/
@@ -16,7 +17,7 @@
 //! so editing `model.json` or swapping in the weights or reference of another model is detected
 //! when loading. The directory is written beside its destination and renamed into place.
 
-use std::fs;
+use std::ops::RangeInclusive;
 use std::path::{Path, PathBuf};
 
 use burn::prelude::*;
@@ -24,11 +25,11 @@ use deepbrdf_data::mapping::MedianReference;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
-use crate::atomic::{check_format, read_limited, read_weights, write_manifest, write_weights};
+use crate::artifact::files::{read_limited, read_weights, write_manifest, write_weights};
+use crate::artifact::{check_id, dir, load_weights, network_bytes, parse_manifest, Part};
 use crate::autoencoder::train::Trained;
 use crate::autoencoder::{retired_network, Autoencoder, AutoencoderConfig};
 use crate::error::{ModelError, Result};
-use deepbrdf_data::files::sync_dir_of;
 
 /// File name of the manifest.
 pub const MANIFEST_FILE: &str = "model.json";
@@ -38,7 +39,6 @@ pub const WEIGHTS_FILE: &str = "weights.bpk";
 pub const REFERENCE_FILE: &str = "median_reference.bin";
 /// Name of the artifact directory that training writes inside its output directory.
 pub const MODEL_DIR: &str = "model";
-const FORMAT: &str = "deepbrdf-model";
 const VERSION: u32 = 2;
 
 /// How a model was trained (§3.2's settings and the data), recorded with the model.
@@ -91,14 +91,6 @@ impl Provenance {
     }
 }
 
-/// Checksum of one part file (also of the networks saved beside a model: [`crate::recovery`]).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub(crate) struct Part {
-    pub(crate) file: String,
-    pub(crate) bytes: u64,
-    pub(crate) sha256: String,
-}
-
 /// The content of `model.json`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 struct Manifest {
@@ -115,24 +107,36 @@ struct Manifest {
     basis: Option<serde_json::Value>,
 }
 
-/// The checksums of an artifact's parts, computed once.
-#[derive(Debug, Clone)]
-struct Parts {
-    weights: Part,
-    reference: Part,
+impl crate::artifact::Manifest for Manifest {
+    const FORMAT: &'static str = "deepbrdf-model";
+    const VERSIONS: RangeInclusive<u32> = 1..=VERSION;
+    const WHAT: &'static str = "a DeepBRDF model";
+
+    fn format(&self) -> (&str, u32) {
+        (&self.format, self.version)
+    }
+
+    fn id(&self) -> &str {
+        &self.id
+    }
+
+    fn content(&self) -> serde_json::Value {
+        serde_json::json!({
+            "config": self.config,
+            "provenance": self.provenance,
+            "weights": self.weights,
+            "reference": self.reference,
+        })
+    }
 }
 
 /// A trained model with its median reference and provenance, in memory.
 #[derive(Debug, Clone)]
 pub struct ModelArtifact {
     config: AutoencoderConfig,
-    /// `config` in the form the manifest holds and the id covers (see [`Manifest::config`]).
-    config_json: serde_json::Value,
-    provenance: Provenance,
+    manifest: Manifest,
     weights: Vec<u8>,
     reference: MedianReference,
-    parts: Parts,
-    id: String,
 }
 
 impl ModelArtifact {
@@ -177,27 +181,27 @@ impl ModelArtifact {
         model: Autoencoder,
         reference: MedianReference,
     ) -> Result<Self> {
-        let weights = model
-            .into_record()
-            .into_bytes()
-            .map_err(|e| ModelError::Invalid(format!("cannot serialise the weights: {e}")))?
-            .to_vec();
-        // Without Burn's random parameter ids, the same network has the same bytes.
-        let weights = crate::record::rewrite(weights, false, |name| name)
-            .map_err(|e| ModelError::Invalid(format!("cannot serialise the weights: {e}")))?;
-        let parts = Parts {
-            weights: part_of(&weights, WEIGHTS_FILE),
+        use crate::artifact::Manifest as _;
+        let weights = network_bytes(model)?;
+        let mut manifest = Manifest {
+            format: <Manifest as crate::artifact::Manifest>::FORMAT.into(),
+            version: VERSION,
+            id: String::new(),
+            config: serde_json::to_value(&config).map_err(|e| {
+                ModelError::Invalid(format!("cannot serialise the configuration: {e}"))
+            })?,
+            provenance,
+            weights: Part::of(&weights, WEIGHTS_FILE),
             reference: reference_part(&reference),
+            basis: None,
         };
-        let config_json = serde_json::to_value(&config)
-            .map_err(|e| ModelError::Invalid(format!("cannot serialise the configuration: {e}")))?;
-        let id = manifest_id(&config_json, &provenance, &parts);
-        Ok(Self { config, config_json, provenance, weights, reference, parts, id })
+        manifest.id = manifest.computed_id();
+        Ok(Self { config, manifest, weights, reference })
     }
 
     /// The id tying configuration, provenance, weights and reference together.
     pub fn id(&self) -> &str {
-        &self.id
+        &self.manifest.id
     }
 
     /// The network's configuration.
@@ -207,7 +211,7 @@ impl ModelArtifact {
 
     /// How the model was trained.
     pub fn provenance(&self) -> &Provenance {
-        &self.provenance
+        &self.manifest.provenance
     }
 
     /// The eq. (1) reference the network's inputs are mapped with.
@@ -234,23 +238,11 @@ impl ModelArtifact {
         if self.weights.is_empty() {
             return Err(ModelError::Invalid("this artifact's weights were handed over".into()));
         }
-        save_dir(dir, MANIFEST_FILE, "a DeepBRDF model", |tmp| self.write_parts(tmp))
-    }
-
-    fn write_parts(&self, dir: &Path) -> Result<()> {
-        write_weights(&dir.join(WEIGHTS_FILE), &self.weights)?;
-        self.reference.save_compressed(dir.join(REFERENCE_FILE))?;
-        let manifest = Manifest {
-            format: FORMAT.into(),
-            version: VERSION,
-            id: self.id.clone(),
-            config: self.config_json.clone(),
-            provenance: self.provenance.clone(),
-            weights: self.parts.weights.clone(),
-            reference: self.parts.reference.clone(),
-            basis: None,
-        };
-        write_manifest(&dir.join(MANIFEST_FILE), &manifest)
+        dir::save(dir, MANIFEST_FILE, "a DeepBRDF model", |tmp| {
+            write_weights(&tmp.join(WEIGHTS_FILE), &self.weights)?;
+            self.reference.save_compressed(tmp.join(REFERENCE_FILE))?;
+            write_manifest(&tmp.join(MANIFEST_FILE), &self.manifest)
+        })
     }
 
     /// Loads an artifact directory, or a training output directory holding one in `model/`,
@@ -259,51 +251,28 @@ impl ModelArtifact {
         let dir = resolve_dir(path)?;
         let manifest_path = dir.join(MANIFEST_FILE);
         let text = read_limited(&manifest_path, 64 << 20)?;
-        let (manifest, config) = parse_manifest(&manifest_path, &text)?;
+        let (manifest, config) = parse(&manifest_path, &text)?;
+        let owner = format!("model {}", manifest.id);
         let weights_path = dir.join(WEIGHTS_FILE);
         let weights = read_weights(&weights_path, 4 << 30)?;
-        if part_of(&weights, WEIGHTS_FILE) != manifest.weights {
-            return Err(ModelError::mismatch(
-                &weights_path,
-                format!("these weights do not belong to model {} (checksum differs)", manifest.id),
-            ));
-        }
+        manifest.weights.check(&weights_path, &weights, "these weights", &owner)?;
         let reference_path = dir.join(REFERENCE_FILE);
         let reference = MedianReference::load(&reference_path)?;
         if reference_part(&reference) != manifest.reference {
             return Err(ModelError::mismatch(
                 &reference_path,
-                format!(
-                    "this median reference does not belong to model {} (checksum differs)",
-                    manifest.id
-                ),
+                format!("this median reference does not belong to {owner} (checksum differs)"),
             ));
         }
-        let parts = Parts { weights: manifest.weights, reference: manifest.reference };
-        if manifest_id(&manifest.config, &manifest.provenance, &parts) != manifest.id {
-            return Err(ModelError::mismatch(
-                &manifest_path,
-                "the manifest was edited or damaged (its id does not match its content)",
-            ));
-        }
-        Ok(Self {
-            config,
-            config_json: manifest.config,
-            provenance: manifest.provenance,
-            weights,
-            reference,
-            parts,
-            id: manifest.id,
-        })
+        check_id(&manifest_path, &manifest)?;
+        Ok(Self { config, manifest, weights, reference })
     }
 }
 
 /// Parses and checks `model.json` (its bytes `text`, read from `path`): format, version and a
 /// valid network configuration (sizes in range, so nothing is allocated for an absurd one).
-fn parse_manifest(path: &Path, text: &[u8]) -> Result<(Manifest, AutoencoderConfig)> {
-    let manifest: Manifest = serde_json::from_slice(text)
-        .map_err(|e| ModelError::format(path, format!("not a DeepBRDF model manifest: {e}")))?;
-    check_format(path, (&manifest.format, manifest.version), FORMAT, 1..=VERSION)?;
+fn parse(path: &Path, text: &[u8]) -> Result<(Manifest, AutoencoderConfig)> {
+    let manifest: Manifest = parse_manifest(path, text)?;
     let retired = match manifest.basis.is_some() {
         true => Some("the spectral network of the retired `cpu` preset, with its basis.f16"),
         false => retired_network(&manifest.config),
@@ -332,122 +301,9 @@ fn reference_part(reference: &MedianReference) -> Part {
     }
 }
 
-/// The id over configuration, provenance and the parts' checksums.
-fn manifest_id(config: &serde_json::Value, provenance: &Provenance, parts: &Parts) -> String {
-    let content = serde_json::json!({
-        "config": config,
-        "provenance": provenance,
-        "weights": parts.weights,
-        "reference": parts.reference,
-    });
-    let digest = Sha256::digest(canonical(content).to_string().as_bytes());
-    hex::encode(&digest[..16])
-}
-
-/// Loads burnpack `weights` into `network` (any network).
-pub(crate) fn load_weights<M: Module>(network: M, weights: Vec<u8>) -> Result<M> {
-    let bad = |e: burn::store::RecordError| {
-        ModelError::Invalid(format!("the weights do not fit the configuration: {e}"))
-    };
-    let record = crate::record::float_record(weights).map_err(|e| {
-        ModelError::Invalid(format!("the weights do not fit the configuration: {e}"))
-    })?;
-    network.try_load_record(record).map_err(bad)
-}
-
-/// `value` with every non-integer number replaced by its 10-significant-digit text, so the id
-/// survives a JSON round trip (serde_json may parse a printed f64 one unit in the last place
-/// away) while any real edit still changes it.
-pub(crate) fn canonical(value: serde_json::Value) -> serde_json::Value {
-    use serde_json::Value;
-    match value {
-        Value::Number(n) if !(n.is_i64() || n.is_u64()) => {
-            Value::String(format!("{:.9e}", n.as_f64().unwrap_or(f64::NAN)))
-        }
-        Value::Array(items) => Value::Array(items.into_iter().map(canonical).collect()),
-        Value::Object(map) => {
-            Value::Object(map.into_iter().map(|(k, v)| (k, canonical(v))).collect())
-        }
-        other => other,
-    }
-}
-
-pub(crate) fn part_of(bytes: &[u8], file: &str) -> Part {
-    Part {
-        file: file.into(),
-        bytes: bytes.len() as u64,
-        sha256: hex::encode(Sha256::digest(bytes)),
-    }
-}
-
 /// `path` itself if it holds a manifest, else `path/model` if that does.
 pub fn resolve_dir(path: &Path) -> Result<PathBuf> {
-    resolve_artifact_dir(path, MANIFEST_FILE, MODEL_DIR, "a DeepBRDF model")
-}
-
-/// `path` itself if it holds `manifest`, else `path/inner` if that does; else an error saying
-/// that `path` is not `what` (an artifact of this crate: a model, a recovery network).
-pub(crate) fn resolve_artifact_dir(
-    path: &Path,
-    manifest: &str,
-    inner: &str,
-    what: &str,
-) -> Result<PathBuf> {
-    if path.join(manifest).is_file() {
-        return Ok(path.to_path_buf());
-    }
-    let inner_dir = path.join(inner);
-    if inner_dir.join(manifest).is_file() {
-        return Ok(inner_dir);
-    }
-    if !path.exists() {
-        return Err(ModelError::io(path, std::io::Error::from(std::io::ErrorKind::NotFound)));
-    }
-    Err(ModelError::format(path, format!("not {what} (no {manifest} here or in {inner}/)")))
-}
-
-/// Writes an artifact directory `dir` with `write_parts` into a temporary sibling and renames
-/// it into place. An existing `dir` is replaced only if it holds `manifest` (it is `what`).
-pub(crate) fn save_dir(
-    dir: &Path,
-    manifest: &str,
-    what: &str,
-    write_parts: impl FnOnce(&Path) -> Result<()>,
-) -> Result<()> {
-    if dir.exists() && !dir.join(manifest).is_file() {
-        return Err(ModelError::Invalid(format!(
-            "{} exists and is not {what}; not replacing it",
-            dir.display()
-        )));
-    }
-    let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = dir.with_file_name(format!(".{name}.tmp{}", std::process::id()));
-    if tmp.exists() {
-        fs::remove_dir_all(&tmp).map_err(|e| ModelError::io(&tmp, e))?;
-    }
-    fs::create_dir_all(&tmp).map_err(|e| ModelError::io(&tmp, e))?;
-    let result = write_parts(&tmp).and_then(|()| replace_dir(&tmp, dir));
-    if result.is_err() {
-        let _ = fs::remove_dir_all(&tmp);
-    }
-    result
-}
-
-/// Moves the finished directory `tmp` to `dir`, replacing an older artifact there.
-fn replace_dir(tmp: &Path, dir: &Path) -> Result<()> {
-    if dir.exists() {
-        let old = tmp.with_extension("old");
-        if old.exists() {
-            fs::remove_dir_all(&old).map_err(|e| ModelError::io(&old, e))?;
-        }
-        fs::rename(dir, &old).map_err(|e| ModelError::io(dir, e))?;
-        fs::rename(tmp, dir).map_err(|e| ModelError::io(dir, e))?;
-        fs::remove_dir_all(&old).map_err(|e| ModelError::io(&old, e))?;
-    } else {
-        fs::rename(tmp, dir).map_err(|e| ModelError::io(dir, e))?;
-    }
-    sync_dir_of(dir);
-    Ok(())
+    dir::resolve(path, MANIFEST_FILE, MODEL_DIR, "a DeepBRDF model")
 }
 
 #[cfg(test)]

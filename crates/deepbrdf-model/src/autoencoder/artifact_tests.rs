@@ -4,6 +4,7 @@
 use super::*;
 use crate::device::DeviceKind;
 use deepbrdf_data::merl::VALUES;
+use std::fs;
 
 pub(super) fn tiny() -> AutoencoderConfig {
     let layers = crate::autoencoder::ConvolutionalConfig::new()
@@ -117,7 +118,7 @@ fn a_model_saved_in_the_earlier_form_loads_with_the_same_id_and_weights() {
     reference.save(&plain_reference).unwrap();
     let plain_reference = fs::read(&plain_reference).unwrap();
     let zstd_reference = zstd::bulk::compress(&plain_reference, 3).unwrap();
-    let record = crate::atomic::read_weights(&packed.join(WEIGHTS_FILE), 1 << 30).unwrap();
+    let record = crate::artifact::files::read_weights(&packed.join(WEIGHTS_FILE), 1 << 30).unwrap();
     let z = Tensor::<2>::from_floats([[0.4, -0.2]], &device);
     let expected: Vec<f32> = model.decode(z.clone()).into_data().try_into_vec().unwrap();
     for (name, reference_bytes) in [("zstd", &zstd_reference), ("plain", &plain_reference)] {

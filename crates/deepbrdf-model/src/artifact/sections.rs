@@ -1,4 +1,4 @@
-//! A small checksummed file of named binary sections, used for training checkpoints.
+//! A small checksummed file of named binary sections: the regressor's file and training checkpoints.
 //!
 //! Layout: the 8-byte magic `DEEPBRDF`, an 8-byte kind tag, a little-endian `u32` section
 //! count, then per section a `u32` name length, the UTF-8 name, a `u64` data length and the
@@ -10,7 +10,7 @@ use std::path::Path;
 
 use sha2::{Digest, Sha256};
 
-use crate::atomic::{read_limited, write_atomic};
+use super::files::{read_limited, write_atomic};
 use crate::error::{ModelError, Result};
 
 const MAGIC: &[u8; 8] = b"DEEPBRDF";

@@ -16,6 +16,7 @@ use deepbrdf_data::testing::mutate::{fuzz, inputs, Focus, Report};
 use super::tests::{provenance, tiny};
 use super::*;
 use crate::device::DeviceKind;
+use std::fs;
 
 fn check(name: &str, report: &Report, started: std::time::Instant) {
     eprintln!("{name}: {report:?} in {:.1} s", started.elapsed().as_secs_f64());
@@ -40,16 +41,16 @@ fn mutated_model_parts_are_refused_or_read_never_a_panic() {
     artifact.save(&dir).unwrap();
     let manifest = fs::read(dir.join(MANIFEST_FILE)).unwrap();
     // The record inside the packed file (the packing's own reader is fuzzed in deepbrdf-data).
-    let weights = crate::atomic::read_weights(&dir.join(WEIGHTS_FILE), 1 << 30).unwrap();
+    let weights = crate::artifact::files::read_weights(&dir.join(WEIGHTS_FILE), 1 << 30).unwrap();
     let n = inputs(2_000);
 
     // The manifest: JSON, format and version, the configuration and its size checks. The
     // unchanged file parses (the test's control).
     let origin = Path::new("model.json");
-    parse_manifest(origin, &manifest).unwrap();
+    parse(origin, &manifest).unwrap();
     let focus = Focus { header: manifest.len(), header_share: 1.0 };
     let t = std::time::Instant::now();
-    let report = fuzz(&[manifest], 21, n, focus, |b| parse_manifest(origin, b));
+    let report = fuzz(&[manifest], 21, n, focus, |b| parse(origin, b));
     check("model.json", &report, t);
 
     // The weights (burnpack): loaded into the network the configuration builds.
@@ -58,8 +59,8 @@ fn mutated_model_parts_are_refused_or_read_never_a_panic() {
     // The crashes fuzzing found (a tensor's dtype field turned into an integer type: Burn
     // panicked inside its loader), kept as regression inputs.
     for (name, bytes) in [
-        ("i32", &include_bytes!("testdata/fuzz/weights-dtype-i32.bpk")[..]),
-        ("u32", &include_bytes!("testdata/fuzz/weights-dtype-u32.bpk")[..]),
+        ("i32", &include_bytes!("../testdata/fuzz/weights-dtype-i32.bpk")[..]),
+        ("u32", &include_bytes!("../testdata/fuzz/weights-dtype-u32.bpk")[..]),
     ] {
         let err = load_weights(network.clone(), bytes.to_vec()).expect_err(name).to_string();
         assert!(err.contains("not as floats"), "{name}: {err}");
