@@ -97,16 +97,33 @@ pub fn default_out(mode: Mode) -> PathBuf {
     PathBuf::from("results").join(format!("baselines-{}", mode.to_string().replace(':', "-")))
 }
 
+impl Args {
+    /// The harness's settings: ks, mode, seed, measures and the one fold asked for.
+    fn harness_config(&self) -> anyhow::Result<HarnessConfig> {
+        let config = HarnessConfig {
+            ks: self.ks.clone(),
+            mode: self.mode,
+            seed: self.seed,
+            measures: self.measures.clone(),
+            only_fold: self.fold,
+        };
+        config.validate()?;
+        Ok(config)
+    }
+
+    /// Sun et al. 2018's split with the asked diffuse dimensions and specular epsilon.
+    fn sun_method(&self) -> SeparatedMethod {
+        SeparatedMethod::new(SeparationConfig {
+            diffuse_dims: self.sun_diffuse_dims,
+            specular_epsilon: self.sun_specular_epsilon,
+            ..SeparationConfig::default()
+        })
+    }
+}
+
 pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let started = Instant::now();
-    let config = HarnessConfig {
-        ks: args.ks.clone(),
-        mode: args.mode,
-        seed: args.seed,
-        measures: args.measures.clone(),
-        only_fold: args.fold,
-    };
-    config.validate()?;
+    let config = args.harness_config()?;
     check(&args)?;
     let out = args.out.clone().unwrap_or_else(|| default_out(args.mode));
     // Held until the run ends: a second run on the same folder is refused.
@@ -124,11 +141,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     };
     let eval_label = eval.as_ref().map(|e| format!("{} ({} materials)", e.label, e.len()));
     let ggx = AttributeMethod::default();
-    let sun = SeparatedMethod::new(SeparationConfig {
-        diffuse_dims: args.sun_diffuse_dims,
-        specular_epsilon: args.sun_specular_epsilon,
-        ..SeparationConfig::default()
-    });
+    let sun = args.sun_method();
     let deep = deep_method(&args, &out, &data_label)?;
     let methods: Vec<&dyn Method> = args
         .methods

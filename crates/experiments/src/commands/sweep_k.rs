@@ -22,7 +22,9 @@ use deepbrdf_data::Progress;
 use deepbrdf_eval::baseline::BaselineMethod;
 use deepbrdf_eval::deep::{DeepMethod, NAME};
 use deepbrdf_eval::figures::slices::{self as slices_figure, FIG2_MATERIAL};
-use deepbrdf_eval::harness::{self, AtKs, HarnessConfig, Materials, Measure, Mode, Results};
+use deepbrdf_eval::harness::{
+    self, AtKs, HarnessConfig, Materials, Measure, Method, Mode, Results,
+};
 use deepbrdf_eval::robustness::{self, Robustness};
 use deepbrdf_eval::saved_sweep::SavedSweep;
 use deepbrdf_eval::sweep_report::{minutes, training_csv, SweepReport};
@@ -232,14 +234,7 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
     let eval = args.load_eval(progress)?;
     let loaded_at = started.elapsed().as_secs_f64();
     let training = training_label(&args, &config_for(deep_ks[0]), &kind.to_string());
-    println!(
-        "sweep-k: {} materials ({}), PCA and IPCA at k = {:?}, DeepBRDF at k = {deep_ks:?}, {} mode, {training}; output in {}",
-        data.names.len(),
-        data.label,
-        args.ks,
-        args.mode,
-        out.display()
-    );
+    announce(&args, &data, &deep_ks, &training, &out);
 
     let (pca, ipca) = (BaselineMethod::pca(), BaselineMethod::ipca());
     let deep = DeepMethod::new(config_for, &models_dir, &data.label, device.clone())
@@ -252,14 +247,8 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
         tables: &e.tables,
         label,
     });
-    let deep_at = AtKs::new(&deep, &deep_ks);
-    let results = harness::run(
-        &[&pca, &ipca, &deep_at],
-        &harness_config,
-        materials,
-        eval_materials,
-        progress,
-    )?;
+    let methods: [&dyn Method; 3] = [&pca, &ipca, &AtKs::new(&deep, &deep_ks)];
+    let results = harness::run(&methods, &harness_config, materials, eval_materials, progress)?;
     results.write(&out)?;
 
     // Fig. 2's reduced inputs, on the materials each fold's models are scored on.
@@ -284,6 +273,18 @@ pub fn run(args: Args, quiet: bool, bars: &dyn Progress) -> anyhow::Result<()> {
         wall,
     };
     write_report(&args, &report, &out)
+}
+
+/// Prints what the sweep is about to do.
+fn announce(args: &Args, data: &StreamedDataset, deep_ks: &[usize], training: &str, out: &Path) {
+    println!(
+        "sweep-k: {} materials ({}), PCA and IPCA at k = {:?}, DeepBRDF at k = {deep_ks:?}, {} mode, {training}; output in {}",
+        data.names.len(),
+        data.label,
+        args.ks,
+        args.mode,
+        out.display()
+    );
 }
 
 /// How DeepBRDF is trained, for the report: the preset or configuration file, and `sample`'s

@@ -103,22 +103,7 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     let (_, _, original) = client.post("/api/original", &json!({"material": args.material}))?;
     // A new roughness value for every preview (a new latent to decode), 0.02 ... 0.18.
     let value = |i: usize| 0.02 * 1.01f64.powi(i as i32);
-    // One warm-up.
-    client.preview(&args.material, value(0), "fast")?;
-    let (mut trip, mut server, mut decode, mut render) = (vec![], vec![], vec![], vec![]);
-    for i in 1..=args.reps.max(1) {
-        let (_, p, seconds) = client.preview(&args.material, value(i), "fast")?;
-        trip.push(seconds);
-        server.push(p["seconds"]["total"].as_f64().unwrap_or(f64::NAN));
-        decode.push(p["seconds"]["decode"].as_f64().unwrap_or(f64::NAN));
-        render.push(p["seconds"]["render"].as_f64().unwrap_or(f64::NAN));
-    }
-    let mut refined = vec![];
-    for i in 0..3 {
-        let (_, _, seconds) = client.preview(&args.material, value(100 + i), "refined")?;
-        refined.push(seconds);
-    }
-
+    let timed = Previews::time(&client, &args.material, args.reps.max(1), &value)?;
     let Burst { answered, superseded, last_sent, last_done, page_max } =
         burst(&client, &args.material, &value)?;
 
@@ -130,22 +115,7 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         rayon::current_num_threads()
     );
     println!("open the material (attribute fit, encode, table sampler): {open:.2} s; original render {original:.2} s");
-    println!(
-        "fast preview (128 px, {} spp), request to image over HTTP: median {:.3} s, max {:.3} s \
-         (target <= 0.300 s); in the editor: {:.3} s (decode {:.3} s, render {:.3} s), {} previews",
-        crate::serve::editor::FAST.spp,
-        finite_median(trip.clone()),
-        max(&trip),
-        finite_median(server),
-        finite_median(decode),
-        finite_median(render),
-        trip.len()
-    );
-    println!(
-        "refined preview (256 px, {} spp, own table sampler, re-estimated attributes): median {:.3} s",
-        crate::serve::editor::REFINED.spp,
-        finite_median(refined)
-    );
+    timed.print();
     println!(
         "burst of 20 moves in {last_sent:.2} s: {answered} answered, {superseded} superseded \
          (409); the last answered {:.3} s after it was sent; page and /api/info during the \
@@ -153,6 +123,62 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         last_done - last_sent
     );
     Ok(())
+}
+
+/// The previews' times in seconds: fast ones over HTTP (`trip`) and as the editor reports them
+/// (total, decode, render), and refined ones over HTTP.
+struct Previews {
+    trip: Vec<f64>,
+    server: Vec<f64>,
+    decode: Vec<f64>,
+    render: Vec<f64>,
+    refined: Vec<f64>,
+}
+
+impl Previews {
+    /// One warm-up, then `reps` fast previews and 3 refined ones, each of a new roughness
+    /// `value(i)` (a new latent to decode).
+    fn time(
+        client: &Client,
+        material: &str,
+        reps: usize,
+        value: &dyn Fn(usize) -> f64,
+    ) -> anyhow::Result<Self> {
+        client.preview(material, value(0), "fast")?;
+        let mut t =
+            Self { trip: vec![], server: vec![], decode: vec![], render: vec![], refined: vec![] };
+        for i in 1..=reps {
+            let (_, p, seconds) = client.preview(material, value(i), "fast")?;
+            t.trip.push(seconds);
+            t.server.push(p["seconds"]["total"].as_f64().unwrap_or(f64::NAN));
+            t.decode.push(p["seconds"]["decode"].as_f64().unwrap_or(f64::NAN));
+            t.render.push(p["seconds"]["render"].as_f64().unwrap_or(f64::NAN));
+        }
+        for i in 0..3 {
+            let (_, _, seconds) = client.preview(material, value(100 + i), "refined")?;
+            t.refined.push(seconds);
+        }
+        Ok(t)
+    }
+
+    fn print(self) {
+        println!(
+            "fast preview (128 px, {} spp), request to image over HTTP: median {:.3} s, max {:.3} s \
+             (target <= 0.300 s); in the editor: {:.3} s (decode {:.3} s, render {:.3} s), {} previews",
+            crate::serve::editor::FAST.spp,
+            finite_median(self.trip.clone()),
+            max(&self.trip),
+            finite_median(self.server),
+            finite_median(self.decode),
+            finite_median(self.render),
+            self.trip.len()
+        );
+        println!(
+            "refined preview (256 px, {} spp, own table sampler, re-estimated attributes): median {:.3} s",
+            crate::serve::editor::REFINED.spp,
+            finite_median(self.refined)
+        );
+    }
 }
 
 /// What the burst of moves measured: the previews answered and superseded, when the last was
