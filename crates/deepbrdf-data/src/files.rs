@@ -1,7 +1,7 @@
 //! Careful file access shared by the binary formats of this crate: reading a whole file after
 //! checking what it is, and atomic writes (temporary file in the same directory, then rename), so
-//! that a crash or a full disk never leaves a half-written file under its final name; and the
-//! removal of the temporary files a killed writer leaves behind.
+//! that a crash or a full disk never leaves a half-written file under its final name (the
+//! temporary files a killed writer leaves behind are removed by [`crate::lock`]).
 
 use crate::error::{DataError, Result};
 use std::fs::File;
@@ -11,40 +11,6 @@ use std::path::Path;
 /// Name prefix and suffix of [`write_atomic_parts`]' temporary files.
 pub const TEMP_PREFIX: &str = ".deepbrdf-";
 pub const TEMP_SUFFIX: &str = ".tmp";
-
-/// Deepest subfolder of a locked folder searched for stale temporary files.
-const MAX_DEPTH: usize = 8;
-
-/// Removes the temporary files of [`write_atomic_parts`] in `dir` and its subfolders (links
-/// not followed, at most 8 levels deep) and returns how many it removed. A writer killed
-/// between creating its temporary file and renaming it (SIGKILL, power loss) cannot remove it
-/// itself; the file never carries a final name, so nothing reads it, but it takes space. Only
-/// call this while holding `dir`'s [`crate::lock::FolderLock`] (no live run writes there); a
-/// subfolder with a lock file of its own belongs to its own run and is left to it.
-pub fn remove_stale_temporaries(dir: &Path) -> Result<usize> {
-    fn sweep(dir: &Path, depth: usize) -> Result<usize> {
-        let mut removed = 0;
-        let entries = std::fs::read_dir(dir).map_err(|e| DataError::io(dir, e))?;
-        for entry in entries {
-            let entry = entry.map_err(|e| DataError::io(dir, e))?;
-            let path = entry.path();
-            let kind = entry.file_type().map_err(|e| DataError::io(&path, e))?;
-            let name = entry.file_name();
-            let name = name.to_string_lossy();
-            if kind.is_file() && name.starts_with(TEMP_PREFIX) && name.ends_with(TEMP_SUFFIX) {
-                std::fs::remove_file(&path).map_err(|e| DataError::io(&path, e))?;
-                removed += 1;
-            } else if kind.is_dir()
-                && depth < MAX_DEPTH
-                && !path.join(crate::lock::LOCK_FILE).exists()
-            {
-                removed += sweep(&path, depth + 1)?;
-            }
-        }
-        Ok(removed)
-    }
-    sweep(dir, 0)
-}
 
 /// Opens `path` for reading and returns the file with its length in bytes. A missing path or a
 /// directory is an error naming the path.
@@ -158,28 +124,6 @@ mod tests {
     use super::*;
 
     type TestResult = std::result::Result<(), Box<dyn std::error::Error>>;
-
-    #[test]
-    fn stale_temporaries_are_removed_outside_other_runs_folders() -> TestResult {
-        let dir = tempfile::tempdir()?;
-        let root = dir.path();
-        std::fs::create_dir_all(root.join("model"))?;
-        std::fs::create_dir_all(root.join("other"))?;
-        write_atomic(&root.join("kept.bin"), b"kept")?;
-        for p in [".deepbrdf-a1.tmp", "model/.deepbrdf-b2.tmp", "other/.deepbrdf-c3.tmp"] {
-            std::fs::write(root.join(p), b"half")?;
-        }
-        // Not ours by name; and a folder locked by (the file of) another run.
-        std::fs::write(root.join("notes.tmp"), b"user")?;
-        std::fs::write(root.join("other").join(crate::lock::LOCK_FILE), b"pid 1\n")?;
-        assert_eq!(remove_stale_temporaries(root)?, 2);
-        assert!(!root.join(".deepbrdf-a1.tmp").exists());
-        assert!(!root.join("model/.deepbrdf-b2.tmp").exists());
-        for kept in ["kept.bin", "notes.tmp", "other/.deepbrdf-c3.tmp"] {
-            assert!(root.join(kept).exists(), "{kept}");
-        }
-        Ok(())
-    }
 
     #[cfg(unix)]
     #[test]

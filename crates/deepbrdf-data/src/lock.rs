@@ -8,9 +8,10 @@
 //! stale lock file left by a dead process is simply locked again by the next run; no pid liveness
 //! guessing is involved. The file stays in the folder after the run (a hidden file of a few bytes).
 //! Taking the lock removes the temporary files a killed run left in the folder
-//! ([`crate::files::remove_stale_temporaries`]).
+//! ([`remove_stale_temporaries`]).
 
 use crate::error::{DataError, Result};
+use crate::files;
 use std::fs::{File, OpenOptions, TryLockError};
 use std::io::{Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
@@ -63,7 +64,7 @@ impl FolderLock {
         file.write_all(record.as_bytes()).map_err(|e| DataError::io(&path, e))?;
         file.sync_all().map_err(|e| DataError::io(&path, e))?;
         // Whatever a killed run of this folder was writing is garbage now.
-        crate::files::remove_stale_temporaries(dir)?;
+        remove_stale_temporaries(dir)?;
         Ok(Self { path, file })
     }
 
@@ -97,9 +98,65 @@ fn read_holder(file: &mut File) -> String {
     }
 }
 
+/// Deepest subfolder of a locked folder searched for stale temporary files.
+const MAX_DEPTH: usize = 8;
+
+/// Removes the temporary files of [`crate::files::write_atomic_parts`] in `dir` and its
+/// subfolders (links not followed, at most 8 levels deep) and returns how many it removed. A
+/// writer killed between creating its temporary file and renaming it (SIGKILL, power loss)
+/// cannot remove it itself; the file never carries a final name, so nothing reads it, but it
+/// takes space. Called while holding `dir`'s [`FolderLock`] (no live run writes there); a
+/// subfolder with a lock file of its own belongs to its own run and is left to it.
+fn remove_stale_temporaries(dir: &Path) -> Result<usize> {
+    fn sweep(dir: &Path, depth: usize) -> Result<usize> {
+        let mut removed = 0;
+        let entries = std::fs::read_dir(dir).map_err(|e| DataError::io(dir, e))?;
+        for entry in entries {
+            let entry = entry.map_err(|e| DataError::io(dir, e))?;
+            let path = entry.path();
+            let kind = entry.file_type().map_err(|e| DataError::io(&path, e))?;
+            let name = entry.file_name();
+            let name = name.to_string_lossy();
+            if kind.is_file()
+                && name.starts_with(files::TEMP_PREFIX)
+                && name.ends_with(files::TEMP_SUFFIX)
+            {
+                std::fs::remove_file(&path).map_err(|e| DataError::io(&path, e))?;
+                removed += 1;
+            } else if kind.is_dir() && depth < MAX_DEPTH && !path.join(LOCK_FILE).exists() {
+                removed += sweep(&path, depth + 1)?;
+            }
+        }
+        Ok(removed)
+    }
+    sweep(dir, 0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn stale_temporaries_are_removed_outside_other_runs_folders() -> TestResult {
+        let dir = tempfile::tempdir()?;
+        let root = dir.path();
+        std::fs::create_dir_all(root.join("model"))?;
+        std::fs::create_dir_all(root.join("other"))?;
+        files::write_atomic(&root.join("kept.bin"), b"kept")?;
+        for p in [".deepbrdf-a1.tmp", "model/.deepbrdf-b2.tmp", "other/.deepbrdf-c3.tmp"] {
+            std::fs::write(root.join(p), b"half")?;
+        }
+        // Not ours by name; and a folder locked by (the file of) another run.
+        std::fs::write(root.join("notes.tmp"), b"user")?;
+        std::fs::write(root.join("other").join(LOCK_FILE), b"pid 1\n")?;
+        assert_eq!(remove_stale_temporaries(root)?, 2);
+        assert!(!root.join(".deepbrdf-a1.tmp").exists());
+        assert!(!root.join("model/.deepbrdf-b2.tmp").exists());
+        for kept in ["kept.bin", "notes.tmp", "other/.deepbrdf-c3.tmp"] {
+            assert!(root.join(kept).exists(), "{kept}");
+        }
+        Ok(())
+    }
 
     type TestResult = std::result::Result<(), Box<dyn std::error::Error>>;
 

@@ -5,6 +5,9 @@
 use crate::error::{RenderError, Result};
 use std::path::Path;
 
+/// Largest image side accepted, rendered or read (memory stays under a few hundred MB).
+pub const MAX_SIZE: u32 = 8192;
+
 /// A linear-radiance RGB image (f32) with per-pixel coverage in [0, 1].
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {
@@ -147,7 +150,7 @@ impl Image {
     }
 
     /// [`Image::read_exr`] of a file's bytes (`origin` names it in errors). The header is read
-    /// first and a layer larger than [`crate::integrator::MAX_SIZE`] on a side is refused
+    /// first and a layer larger than [`MAX_SIZE`] on a side is refused
     /// before any pixel memory is allocated.
     pub fn exr_from_bytes(bytes: &[u8], origin: &Path) -> Result<Self> {
         use exr::prelude::*;
@@ -156,7 +159,7 @@ impl Image {
         };
         let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
             .map_err(bad)?;
-        let max = crate::integrator::MAX_SIZE as usize;
+        let max = MAX_SIZE as usize;
         for header in &meta.headers {
             let size = header.layer_size;
             if size.width() > max || size.height() > max {

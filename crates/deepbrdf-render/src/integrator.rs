@@ -14,7 +14,7 @@
 
 use super::brdf::{Brdf, Rgb};
 use super::geometry::{Frame, Vec3};
-use super::image::Image;
+use super::image::{Image, MAX_SIZE};
 use super::light::MAX_STRATEGIES;
 use super::sampler::{PixelSampler, Sampler, MAX_SOBOL_SAMPLES};
 use super::scene::Scene;
@@ -23,8 +23,6 @@ use deepbrdf_data::Progress;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-/// Largest image side accepted (memory stays under a few hundred MB).
-pub const MAX_SIZE: u32 = 8192;
 /// Largest sample count per pixel accepted.
 pub const MAX_SPP: u32 = MAX_SOBOL_SAMPLES;
 

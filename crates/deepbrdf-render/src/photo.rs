@@ -382,7 +382,7 @@ mod tests {
     #[test]
     fn an_exr_larger_than_the_limit_is_refused_before_its_pixels_are_read() {
         let dir = tempfile::tempdir().unwrap();
-        let wide = crate::integrator::MAX_SIZE + 1;
+        let wide = crate::image::MAX_SIZE + 1;
         let n = wide as usize;
         let path = dir.path().join("wide.exr");
         Image::from_pixels(wide, 1, vec![[0.5; 3]; n], vec![1.0; n])

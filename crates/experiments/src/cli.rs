@@ -1,5 +1,6 @@
 //! Command-line definition. Each subcommand's arguments live in its own file under `commands/`.
 use crate::commands;
+use crate::progress::Bars;
 use clap::{Parser, Subcommand};
 
 /// DeepBRDF: a deep, compact and editable representation of measured BRDFs (Hu et al., CGF 2020).
@@ -120,4 +121,51 @@ pub enum Command {
 
 fn parse_device(s: &str) -> Result<deepbrdf_model::DeviceKind, String> {
     s.parse()
+}
+
+impl Cli {
+    /// Runs the parsed command.
+    pub fn run(self) -> anyhow::Result<()> {
+        let cli = self;
+        let progress = Bars::new(cli.quiet);
+        crate::args::device::select(cli.device);
+        match cli.command {
+            Command::Devices(args) => commands::devices::run(args, &progress),
+            Command::Bench(args) => commands::bench::run(args, &progress),
+            Command::FetchMerl(args) => commands::fetch_merl::run(args, cli.quiet),
+            Command::Info(args) => commands::info::run(args, &progress),
+            Command::Folds(args) => commands::folds::run(args, &progress),
+            Command::Tabulate(args) => commands::tabulate::run(args, &progress),
+            Command::PackNbrdf(args) => commands::pack_nbrdf::run(args, &progress),
+            Command::Compact(args) => commands::compact::run(args, &progress),
+            Command::Corpus(args) => commands::corpus::run(args, &progress),
+            Command::Train(args) => commands::train::run(args, &progress),
+            Command::Encode(args) => commands::encode::run(args, &progress),
+            Command::Decode(args) => commands::decode::run(args, &progress),
+            Command::Reconstruct(args) => commands::reconstruct::run(args, &progress),
+            Command::Highlights(args) => commands::highlights::run(args, &progress),
+            Command::SweepK(args) => commands::sweep_k::run(args, cli.quiet, &progress),
+            Command::Render(args) => commands::render::run(args, &progress),
+            Command::Compare(args) => commands::compare::run(args, &progress),
+            Command::Convert(args) => commands::convert::run(args, &progress),
+            Command::ExportBsdf(args) => commands::export_bsdf::run(args, &progress),
+            Command::RoundTrip(args) => commands::round_trip::run(args, &progress),
+            Command::Sheet(args) => commands::sheet::run(args, &progress),
+            Command::Serve(args) => commands::serve::run(args, &progress),
+            Command::Baselines(args) => commands::baselines::run(args, &progress),
+            Command::Attributes(args) => commands::attributes::run(args, &progress),
+            Command::TrainRegressor(args) => commands::train_regressor::run(args, &progress),
+            Command::Edit(args) => commands::edit::run(args, &progress),
+            Command::Interpolate(args) => commands::interpolate::run(args, &progress),
+            Command::FiguresEditing(args) => commands::figures_editing::run(args, &progress),
+            Command::EditKnown(args) => commands::edit_known::run(args, &progress),
+            Command::FiguresGeneralize(args) => commands::figures_generalize::run(args, &progress),
+            Command::FiguresLoss(args) => commands::figures_loss::run(args, &progress),
+            Command::FiguresQuality(args) => commands::figures_quality::run(args, &progress),
+            Command::RenderSet(args) => commands::render_set::run(args, &progress),
+            Command::TrainRecovery(args) => commands::train_recovery::run(args, &progress),
+            Command::Recover(args) => commands::recover::run(args, &progress),
+            Command::FiguresRecovery(args) => commands::figures_recovery::run(args, &progress),
+        }
+    }
 }
