@@ -40,9 +40,11 @@ pub fn luminance(rgb: [f64; 3]) -> f64 {
     0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
 }
 
-/// Resolutions of the written parameterization. The defaults are those of the RGL database's
-/// isotropic files (8 incidence angles, 128-node NDF and projected area, 128 x 128 VNDF, 32 x 32
-/// RGB samples per incidence angle).
+/// Resolutions of the written parameterization. The defaults (64 incidence angles, 128-node NDF
+/// and projected area, 32 x 32 VNDF, 160 x 160 RGB samples per incidence angle) are finer than
+/// the RGL database's isotropic files (8, 128, 128 x 128, 32 x 32): a file resampled from a
+/// table needs them to reflect as much light as the table at grazing angles (docs/data.md
+/// measures both).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ExportResolution {
     /// Incidence angles (`theta_i`), at least 2.
@@ -57,11 +59,14 @@ pub struct ExportResolution {
 
 impl Default for ExportResolution {
     fn default() -> Self {
-        Self { theta_i: 8, ndf: 128, vndf: 128, rgb: 32 }
+        Self { theta_i: 64, ndf: 128, vndf: 32, rgb: 160 }
     }
 }
 
 impl ExportResolution {
+    /// The resolutions of the RGL database's isotropic files.
+    pub const RGL_DATABASE: Self = Self { theta_i: 8, ndf: 128, vndf: 128, rgb: 32 };
+
     /// Checks every resolution is in `2..=max` (the upper bounds keep the file under 1 GB).
     pub fn validate(&self) -> Result<()> {
         for (name, value, max) in [
@@ -107,6 +112,18 @@ fn check_table(table: &MerlTable) -> Result<()> {
     }
     Ok(())
 }
+
+/// Share of the uniform density in each `vndf` slice. The readers only use the VNDF table as the
+/// warp from the unit square, where `rgb` is interpolated, to half vectors (and sample by it with
+/// its own density), so any positive density is exact at the nodes. The visible normal density
+/// alone vanishes towards the normal (the `u sin(theta_m)` area factor) and, at grazing
+/// incidence, towards half vectors facing away: there one row or column of `rgb` nodes spans a
+/// wide range of half vectors, across the horizon, and bilinear interpolation there loses the
+/// table. The uniform share bounds that stretch (docs/data.md measures it).
+const UNIFORM_WARP_SHARE: f64 = 0.5;
+
+/// How far above the horizon (radians) the slice of incidence angle pi/2 reads the table.
+const GRAZING_MARGIN: f64 = 1e-4;
 
 /// A unit direction at polar angle `theta` and azimuth `phi`.
 fn direction(theta: f64, phi: f64) -> [f64; 3] {
@@ -191,8 +208,9 @@ pub fn export(
     TensorFile::from_fields(path, fields)
 }
 
-/// The `vndf` field: per incidence angle, `D(m) <wi, m>+ u sin(theta_m)` on a `side x side` grid
-/// of (relative azimuth rows, `u` columns), each slice scaled to sum to 1.
+/// The `vndf` field: per incidence angle, on a `side x side` grid of (relative azimuth rows, `u`
+/// columns), the visible normal density `D(m) <wi, m>+ u sin(theta_m)` scaled to sum to 1, mixed
+/// with the uniform density ([`UNIFORM_WARP_SHARE`]).
 fn vndf_table(ndf: &Marginal2D, theta_i: &[f32], side: usize) -> Vec<f32> {
     let step = 1.0 / (side - 1) as f64;
     theta_i
@@ -212,7 +230,9 @@ fn vndf_table(ndf: &Marginal2D, theta_i: &[f32], side: usize) -> Vec<f32> {
                 })
                 .collect();
             let sum: f64 = slice.iter().sum();
-            slice.iter_mut().for_each(|v| *v /= sum);
+            let uniform = 1.0 / (side * side) as f64;
+            let share = UNIFORM_WARP_SHARE;
+            slice.iter_mut().for_each(|v| *v = (1.0 - share) * *v / sum + share * uniform);
             slice.into_iter().map(|v| v as f32)
         })
         .collect()
@@ -238,7 +258,9 @@ impl Samples<'_> {
     fn slice(&self, theta_i: f32) -> Slice {
         let m = self.side;
         let params = [0.0f32, theta_i];
-        let wi = direction(f64::from(theta_i), 0.0);
+        // The last node is the horizon itself (pi/2 rounded to f32 lies just below it): the
+        // slice holds the limit of the table towards it, read just above.
+        let wi = direction(f64::from(theta_i).min(FRAC_PI_2 - GRAZING_MARGIN), 0.0);
         let u_wi = [(theta_i / std::f32::consts::FRAC_PI_2).sqrt(), 0.5];
         let four_sigma = 4.0 * f64::from(self.sigma.eval(u_wi, &[]));
         let mut out = Slice {
@@ -267,9 +289,47 @@ impl Samples<'_> {
             }
             out.luminance[i] = (luminance(f) * scale).max(0.0) as f32;
         }
+        out.fill_horizon(m);
         if !out.luminance.iter().any(|&l| l > 0.0) {
             out.luminance.iter_mut().for_each(|l| *l = 1.0);
         }
         out
+    }
+}
+
+impl Slice {
+    /// Gives each node below the horizon that borders a node above it the mean of those
+    /// neighbours, so a cell the horizon crosses is not darkened towards zero.
+    fn fill_horizon(&mut self, m: usize) {
+        let valid = self.valid.clone();
+        for i in 0..m * m {
+            if valid[i] {
+                continue;
+            }
+            let (row, col) = (i / m, i % m);
+            let mut near = Vec::with_capacity(4);
+            if row > 0 {
+                near.push(i - m);
+            }
+            if row + 1 < m {
+                near.push(i + m);
+            }
+            if col > 0 {
+                near.push(i - 1);
+            }
+            if col + 1 < m {
+                near.push(i + 1);
+            }
+            near.retain(|&j| valid[j]);
+            if near.is_empty() {
+                continue;
+            }
+            let k = near.len() as f32;
+            for c in 0..3 {
+                self.rgb[c * m * m + i] =
+                    near.iter().map(|&j| self.rgb[c * m * m + j]).sum::<f32>() / k;
+            }
+            self.luminance[i] = near.iter().map(|&j| self.luminance[j]).sum::<f32>() / k;
+        }
     }
 }

@@ -1,6 +1,7 @@
 //! Tests of the RGL writer: exported tables read back through the project's own reader and
 //! evaluator reproduce the table, and bad tables are refused.
 
+use super::albedo::albedo_ratios;
 use super::{export, ExportResolution, RglBrdf, TensorFile};
 use crate::merl::grid::CELLS;
 use crate::merl::VALUES;
@@ -54,28 +55,46 @@ fn exported(table: &MerlTable, resolution: &ExportResolution) -> RglBrdf {
 #[test]
 fn exported_tables_read_back_and_reproduce_the_table() {
     let res = ExportResolution::default();
-    let cases = [
-        ("lambertian", lambertian_table([0.6, 0.4, 0.2]), 0.02),
+    for ((name, table), tolerance) in analytic_materials().into_iter().zip([0.002, 0.002, 0.002]) {
+        let brdf = exported(&table, &res);
+        let e = relative_error(&table, &brdf, 75.0);
+        eprintln!("{name}: relative error of the exported evaluator {e:.4}");
+        assert!(e < tolerance, "{name}: {e}");
+    }
+}
+
+/// The analytic materials of these tests: a Lambertian, a GGX plastic (alpha 0.15, f0 0.04 with
+/// Schlick's Fresnel, so its highlight brightens towards grazing) and a GGX metal (alpha 0.3).
+fn analytic_materials() -> [(&'static str, MerlTable); 3] {
+    [
+        ("lambertian", lambertian_table([0.6, 0.4, 0.2])),
         (
             "plastic",
             tabulate(|wi, wo| {
                 ggx(&Ggx { alpha: 0.15, f0: [0.04; 3], diffuse: [0.3, 0.5, 0.2] }, wi, wo)
             }),
-            0.05,
         ),
         (
             "metal",
             tabulate(|wi, wo| {
                 ggx(&Ggx { alpha: 0.3, f0: [0.9, 0.6, 0.3], diffuse: [0.0; 3] }, wi, wo)
             }),
-            0.05,
         ),
-    ];
-    for (name, table, tolerance) in cases {
-        let brdf = exported(&table, &res);
-        let e = relative_error(&table, &brdf, 75.0);
-        eprintln!("{name}: relative error of the exported evaluator {e:.4}");
-        assert!(e < tolerance, "{name}: {e}");
+    ]
+}
+
+/// At the default resolution the file reflects as much light as the table from every direction
+/// up to 85 degrees, within 2%.
+#[test]
+fn exported_tables_keep_their_directional_albedo() {
+    let angles: Vec<f64> = (0..=17).map(|i| 5.0 * i as f64).collect();
+    for (name, table) in analytic_materials() {
+        let brdf = exported(&table, &ExportResolution::default());
+        let ratios = albedo_ratios(&table, &brdf, &angles);
+        eprintln!("{name}: albedo file / table at 0, 5, ..., 85 deg {ratios:.4?}");
+        for (deg, r) in angles.iter().zip(&ratios) {
+            assert!((r - 1.0).abs() <= 0.02, "{name} at {deg} deg: {r:.4}");
+        }
     }
 }
 

@@ -22,7 +22,7 @@ pub struct Args {
     /// bundled measurement).
     pub measurements: Vec<String>,
     /// An export resolution, `THETA_I,NDF,VNDF,RGB` (repeat for several; default the database's
-    /// 8,128,128,32 and the finer 32,128,128,64).
+    /// 8,128,128,32 and `export-bsdf`'s default, 64,128,32,160).
     #[arg(long = "resolution", value_name = "T,N,V,R", value_parser = parse_resolution)]
     pub resolutions: Vec<ExportResolution>,
     #[command(flatten)]
@@ -48,10 +48,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let setup = args.scene.setup(256)?;
     let cache = args.cache.cache();
     let resolutions = match args.resolutions.is_empty() {
-        true => vec![
-            ExportResolution::default(),
-            ExportResolution { theta_i: 32, rgb: 64, ..ExportResolution::default() },
-        ],
+        true => vec![ExportResolution::RGL_DATABASE, ExportResolution::default()],
         false => args.resolutions.clone(),
     };
     let specs: Vec<String> = match args.measurements.is_empty() {
