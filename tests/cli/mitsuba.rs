@@ -1,6 +1,6 @@
 //! Mitsuba 3 itself renders what `export-bsdf` writes as the project renders the source table:
-//! for MERL materials of several kinds (diffuse, glossy plastic, smooth and rough metals, a
-//! fabric with a grazing sheen, a blend, an edit), the exported `.bsdf` rendered by Mitsuba's
+//! for materials of several kinds (MERL's diffuse, glossy plastic, smooth and rough metals and a
+//! fabric with a grazing sheen; a retro-reflective fabric; a blend; an edit), the exported `.bsdf` rendered by Mitsuba's
 //! `measured` BSDF (`scripts/mitsuba-render.py`, variant scalar_rgb) and the table rendered by
 //! `experiments render`, same sphere, directional light and orthographic camera, differ by image
 //! RelAE at most [`BAR`] beyond the Monte Carlo noise (Mitsuba's render with another seed against
@@ -13,6 +13,7 @@
 //! Without it the test prints why and passes, unless `DEEPBRDF_REQUIRE_MITSUBA=1` (set by
 //! `.ci/run`), where its absence is a failure.
 use crate::util;
+use deepbrdf_data::corpus::retro::Retro;
 use deepbrdf_data::merl::MerlTable;
 use deepbrdf_data::rgl::albedo::albedo_ratios;
 use deepbrdf_eval::metrics::relae;
@@ -124,6 +125,15 @@ fn mitsuba_renders_exported_files_like_the_project() {
         d.join("blend.binary"),
     )
     .expect("write blend");
+    // A retro-reflective fabric: a Lambertian base and a Lafortune lobe back towards the light.
+    let retro = Retro { colour: [0.35, 0.25, 0.3], exponent: 8.0 };
+    let fabric = deepbrdf_data::corpus::tabulate(|wi, wo| {
+        let lobe = retro.eval(wi, wo);
+        let base = [0.3, 0.15, 0.2].map(|a| a / std::f64::consts::PI);
+        [0, 1, 2].map(|c| if wi[2] > 0.0 && wo[2] > 0.0 { base[c] + lobe[c] } else { 0.0 })
+    })
+    .expect("retro-reflective table");
+    deepbrdf_data::merl::write_merl(&fabric, d.join("retro.binary")).expect("write retro");
     run(&["edit", "red-plastic", "--roughness-scale", "2", "-o", "edit.binary", "--cache", &cache]);
     let mut worst = f64::NEG_INFINITY;
     for (kind, spec) in [
@@ -132,6 +142,7 @@ fn mitsuba_renders_exported_files_like_the_project() {
         ("metal", "nickel"),
         ("rough metal", "alum-bronze"),
         ("fabric", "pink-fabric"),
+        ("retro-reflective fabric", "retro.binary"),
         ("blend", "blend.binary"),
         ("edit", "edit.binary"),
     ] {
