@@ -1,4 +1,5 @@
 //! `deepbrdf-data`: measured BRDF data for DeepBRDF (Hu et al., CGF 2020, §3.1).
+pub mod albedo;
 pub mod augment;
 pub mod bundled;
 pub mod cache;

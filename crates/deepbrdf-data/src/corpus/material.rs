@@ -119,6 +119,20 @@ impl Material {
         }
     }
 
+    /// The material with every weight multiplied by `k` (in [0, 1]): the base's albedo, the
+    /// lobes' tints, the sheen's and the retro-reflective lobe's colours; shapes, indices and
+    /// the coat stay.
+    pub fn scaled(&self, k: f64) -> Material {
+        let times = |v: [f64; 3]| v.map(|x| x * k);
+        Material {
+            diffuse: self.diffuse.map(|d| d.with_albedo(times(d.albedo()))),
+            lobes: self.lobes.iter().map(|l| Lobe { tint: times(l.tint), ..*l }).collect(),
+            sheen: self.sheen.map(|s| Sheen { colour: times(s.colour), ..s }),
+            retro: self.retro.map(|r| Retro { colour: times(r.colour), ..r }),
+            ..self.clone()
+        }
+    }
+
     /// Checks every parameter against its range; the error names the field.
     pub fn validate(&self) -> Result<()> {
         let nothing = self.diffuse.is_none()

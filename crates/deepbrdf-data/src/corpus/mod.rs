@@ -10,6 +10,7 @@ pub(crate) mod checks;
 pub mod coat;
 pub mod conductors;
 pub mod diffuse;
+pub mod energy;
 pub mod file;
 pub mod fresnel;
 pub mod material;

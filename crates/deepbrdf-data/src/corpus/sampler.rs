@@ -3,11 +3,13 @@
 //! dielectric indices over [`DIELECTRIC_ETA`], metals from the measured IOR table
 //! ([`super::conductors`]). Material `index` of `seed` depends only on (seed, index): its
 //! generator is ChaCha8 seeded with `seed` on stream `index`, so a corpus is generated in any
-//! order, in parallel, and resumed by index range.
+//! order, in parallel, and resumed by index range. A material whose parts together would reflect
+//! more light than arrives is scaled down ([`super::energy`]).
 
 use super::coat::Coat;
 use super::conductors::conductors;
 use super::diffuse::Diffuse;
+use super::energy;
 use super::fresnel::Fresnel;
 use super::material::{Family, Material};
 use super::microfacet::{Distribution, Lobe};
@@ -106,7 +108,7 @@ fn draw(family: Family, rng: &mut ChaCha8Rng) -> Material {
             }
         }
     }
-    m
+    energy::conserve(m)
 }
 
 /// A Lambertian or (half of the time) Oren-Nayar base.

@@ -8,8 +8,6 @@ use super::request::EditedAttribute;
 use crate::attributes::Attributes;
 use deepbrdf_data::merl::{CELLS, N_THETA_D};
 use deepbrdf_data::MerlTable;
-use rayon::prelude::*;
-use std::f64::consts::PI;
 
 fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
@@ -100,36 +98,7 @@ pub fn is_monotone(values: &[f64], increasing: bool, tolerance: f64) -> bool {
     })
 }
 
-/// Strata per axis of [`directional_albedo`]'s quadrature.
-const STRATA: usize = 96;
-
-/// Directional albedo of `table` for light arriving at polar angle `theta_i` (radians), per
-/// channel: `a(wi) = ∫ f(wi, wo) cos θo dωo`, by a midpoint rule over `STRATA`^2 cells of the
-/// cosine-weighted hemisphere (`wo = (sqrt(u) cos 2πv, sqrt(u) sin 2πv, sqrt(1 - u))`, so
-/// `a = π mean f`), interpolated lookups (deterministic). A narrow specular peak is sampled
-/// coarsely, so the value of a mirror-like table carries a quadrature error of some percent.
-pub fn directional_albedo(table: &MerlTable, theta_i: f64) -> [f64; 3] {
-    let wi = [theta_i.sin(), 0.0, theta_i.cos()];
-    let sums: Vec<[f64; 3]> = (0..STRATA)
-        .into_par_iter()
-        .map(|i| {
-            let mut s = [0f64; 3];
-            let u = (i as f64 + 0.5) / STRATA as f64;
-            let r = u.sqrt();
-            for j in 0..STRATA {
-                let phi = 2.0 * PI * (j as f64 + 0.5) / STRATA as f64;
-                let wo = [r * phi.cos(), r * phi.sin(), (1.0 - u).sqrt()];
-                let f = table.lookup_interpolated(wi, wo);
-                for c in 0..3 {
-                    s[c] += f64::from(f[c]);
-                }
-            }
-            s
-        })
-        .collect();
-    let n = (STRATA * STRATA) as f64;
-    std::array::from_fn(|c| PI * sums.iter().map(|s| s[c]).sum::<f64>() / n)
-}
+pub use deepbrdf_data::albedo::directional_albedo;
 
 /// The physical plausibility of a table.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -11,6 +11,8 @@ pub mod suite;
 use crate::error::{EvalError, Result};
 use crate::metrics::{ImageRelae, ImageRelaeConfig};
 use crate::stats::finite_median;
+use deepbrdf_data::albedo::directional_albedo;
+use deepbrdf_data::rgl::export::luminance;
 use deepbrdf_data::MerlTable;
 use std::fmt::Write as _;
 
@@ -33,6 +35,9 @@ pub struct KnownEdit {
     /// Whether the edit left a dark hole at the highlight that the original did not have
     /// ([`super::lobe::dark_hole`]); `None` where the lobe could not be read.
     pub dark_hole: Option<bool>,
+    /// The largest relative difference of the edited table's directional albedo from the
+    /// answer's over [`ALBEDO_ANGLES_DEG`] ([`albedo_error`]).
+    pub albedo_error: f64,
 }
 
 impl KnownEdit {
@@ -50,6 +55,38 @@ impl KnownEdit {
     pub fn farther(&self) -> bool {
         !(self.ratio() <= 1.0)
     }
+
+    /// Whether the edit reflects what the answer reflects, within [`ALBEDO_TOLERANCE`], from
+    /// every incidence of [`ALBEDO_ANGLES_DEG`].
+    pub fn albedo_kept(&self) -> bool {
+        self.albedo_error <= ALBEDO_TOLERANCE
+    }
+}
+
+/// Incidence angles (degrees) at which an edit's energy is compared with the answer's: grazing
+/// ones included, where a floor or a table top is seen.
+pub const ALBEDO_ANGLES_DEG: [f64; 5] = [0.0, 30.0, 60.0, 75.0, 85.0];
+/// Relative albedo difference within which an edit keeps the answer's energy.
+pub const ALBEDO_TOLERANCE: f64 = 0.1;
+
+/// The directional albedo's luminance of `table` at each of [`ALBEDO_ANGLES_DEG`]
+/// ([`deepbrdf_data::albedo`]).
+pub fn albedos(table: &MerlTable) -> [f64; 5] {
+    ALBEDO_ANGLES_DEG.map(|deg| luminance(directional_albedo(table, deg.to_radians())))
+}
+
+/// The largest `|a_edited / a_answer - 1|` over [`ALBEDO_ANGLES_DEG`], from the answer's
+/// [`albedos`] (infinite where the answer reflects nothing and the edit does).
+pub fn albedo_error(answer: &[f64; 5], edited: &MerlTable) -> f64 {
+    answer
+        .iter()
+        .zip(albedos(edited))
+        .map(|(&want, got)| match want > 0.0 {
+            true => (got / want - 1.0).abs(),
+            false if got > 0.0 => f64::INFINITY,
+            false => 0.0,
+        })
+        .fold(0.0, f64::max)
 }
 
 /// The distances of `original` (unedited) and of each of `edited` from `answer`, in that order
@@ -84,6 +121,8 @@ pub struct KnownTally {
     pub median_ratio: f64,
     /// Edits that left a dark hole.
     pub dark_holes: usize,
+    /// Edits whose albedo stayed within [`ALBEDO_TOLERANCE`] of the answer's.
+    pub albedo_kept: usize,
 }
 
 impl KnownTally {
@@ -97,6 +136,7 @@ impl KnownTally {
             farther: rows.iter().filter(|r| r.farther()).count(),
             median_ratio: finite_median(ratios),
             dark_holes: rows.iter().filter(|r| r.dark_hole == Some(true)).count(),
+            albedo_kept: rows.iter().filter(|r| r.albedo_kept()).count(),
         }
     }
 }
@@ -115,14 +155,14 @@ pub fn markdown(rows: &[KnownEdit]) -> String {
         }
     }
     let mut md = String::from(
-        "| method | edit | edits | at most half as far | farther than unedited | median ratio | dark holes |\n\
-         | --- | --- | ---: | ---: | ---: | ---: | ---: |\n",
+        "| method | edit | edits | at most half as far | farther than unedited | median ratio | dark holes | albedo within 10% at 0-85 deg |\n\
+         | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |\n",
     );
     let mut line = |method: &str, edit: &str, t: KnownTally| {
         let _ = writeln!(
             md,
-            "| {method} | {edit} | {} | {} | {} | {:.3} | {} |",
-            t.edits, t.halved, t.farther, t.median_ratio, t.dark_holes
+            "| {method} | {edit} | {} | {} | {} | {:.3} | {} | {} |",
+            t.edits, t.halved, t.farther, t.median_ratio, t.dark_holes, t.albedo_kept
         );
     };
     for &method in &methods {
@@ -138,10 +178,10 @@ pub fn markdown(rows: &[KnownEdit]) -> String {
 }
 
 /// The rows as CSV (material, edit, method, unedited, edited, ratio, halves, farther, dark
-/// hole: yes, no, or empty where not measured).
+/// hole: yes, no, or empty where not measured; the albedo error).
 pub fn csv(rows: &[KnownEdit]) -> String {
     let mut out = String::from(
-        "material,edit,method,unedited_relae,edited_relae,ratio,halves,farther,dark_hole\n",
+        "material,edit,method,unedited_relae,edited_relae,ratio,halves,farther,dark_hole,albedo_error\n",
     );
     for r in rows {
         let hole = match r.dark_hole {
@@ -151,7 +191,7 @@ pub fn csv(rows: &[KnownEdit]) -> String {
         };
         let _ = writeln!(
             out,
-            "{},{},{},{:.6},{:.6},{:.6},{},{},{hole}",
+            "{},{},{},{:.6},{:.6},{:.6},{},{},{hole},{:.6}",
             r.material,
             r.edit,
             r.method,
@@ -159,7 +199,8 @@ pub fn csv(rows: &[KnownEdit]) -> String {
             r.edited,
             r.ratio(),
             r.halves(),
-            r.farther()
+            r.farther(),
+            r.albedo_error
         );
     }
     out
@@ -179,6 +220,7 @@ mod tests {
             unedited,
             edited,
             dark_hole: Some(edited > unedited),
+            albedo_error: edited,
         }
     }
 
@@ -197,11 +239,12 @@ mod tests {
         let md = markdown(&rows);
         assert_eq!(t.dark_holes, 1);
         assert!(md.contains("| a | x2 | 2 | 1 | 1 |"), "{md}");
-        assert!(md.contains("| a | **all** | 3 | 1 | 1 | 0.750 | 1 |"), "{md}");
+        // Albedo errors (here the edited distances) 0.1, 0.21, 0.15: one within 10%.
+        assert!(md.contains("| a | **all** | 3 | 1 | 1 | 0.750 | 1 | 1 |"), "{md}");
         assert!(md.contains("| b | x2 | 1 | 0 | 1 |"), "{md}");
         let csv = csv(&rows);
         assert_eq!(csv.lines().count(), 5);
-        assert!(csv.lines().nth(2).unwrap().ends_with(",true,yes"), "{csv}");
+        assert!(csv.lines().nth(2).unwrap().ends_with(",true,yes,0.210000"), "{csv}");
     }
 
     #[test]

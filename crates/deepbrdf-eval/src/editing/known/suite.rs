@@ -5,7 +5,7 @@
 //! the same material with the parameter changed; each method's edit is scored by its distance
 //! to the answer against the unedited material's ([`super::distances`]).
 
-use super::{distances, KnownEdit};
+use super::{albedo_error, albedos, distances, KnownEdit};
 use crate::attributes::{self, Attributes, FitConfig};
 use crate::editing::{
     judge_edit, stretch_edit, ColourEdit, Edit, EditMode, Lobe, ScalarEdit, Space,
@@ -216,6 +216,7 @@ pub fn run(input: &KnownInput, progress: &dyn Progress) -> Result<KnownRun> {
             }
             let in_case = |e: EvalError| context(&format!(" {}", case.name), e);
             let answer = case.answer.table().map_err(|e| in_case(e.into()))?;
+            let answer_albedos = albedos(&answer);
             let tables = input
                 .methods
                 .iter()
@@ -232,6 +233,7 @@ pub fn run(input: &KnownInput, progress: &dyn Progress) -> Result<KnownRun> {
                     unedited,
                     edited,
                     dark_hole: judged.map(|l| l.comparison.dark_hole),
+                    albedo_error: albedo_error(&answer_albedos, t),
                 });
             }
         }
