@@ -293,13 +293,20 @@ impl Model {
             true => Some(self.regressor()?),
             false => None,
         };
-        let edited = py
+        let (edited, notes) = py
             .detach(|| {
                 let original = fit(&table, &FitConfig::default())?.attributes;
                 let editor = regressor.map(|r| (&self.model, r));
-                edit_material(&table, &original, &edit, mode, editor)
+                let notes = edit.without_effect(&original);
+                edit_material(&table, &original, &edit, mode, editor).map(|e| (e, notes))
             })
             .map_err(py_err)?;
+        // What the edit cannot change (an albedo the fit finds none of) is a UserWarning.
+        let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+        for note in notes {
+            let message = std::ffi::CString::new(note).map_err(|e| value_error(e.to_string()))?;
+            PyErr::warn(py, &category, &message, 1)?;
+        }
         table_out(py, edited.table)
     }
 

@@ -75,6 +75,9 @@ def test_edit_changes_the_attribute_asked_for(model, chrome):
         model.edit(chrome, roughness=0.1, roughness_scale=2)
     with pytest.raises(ValueError, match="edit mode"):
         model.edit(chrome, roughness=0.1, mode="sideways")
+    # An albedo the fit finds none of cannot be scaled: said, not silently ignored.
+    with pytest.warns(UserWarning, match="no diffuse albedo"):
+        model.edit(deepbrdf.bundled("gold-metallic-paint"), diffuse_scale=0.5)
 
 
 def test_render_recover_and_relae(model, chrome, tmp_path):

@@ -69,6 +69,9 @@ pub enum EditedAttribute {
     None,
 }
 
+/// An albedo below this in every channel is none, for [`Edit::without_effect`].
+pub const NO_ALBEDO: f64 = 1e-3;
+
 /// The edit of a material: `None` leaves an attribute as it is.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Edit {
@@ -123,6 +126,26 @@ impl Edit {
         }
     }
 
+    /// What of this edit cannot change `a`, in words: scaling an albedo the fit finds none of
+    /// (every channel below [`NO_ALBEDO`]) leaves it at nothing, though a person may see a
+    /// glow they would call that albedo (a broad lobe the fit took as specular). Empty when
+    /// every part of the edit acts.
+    pub fn without_effect(&self, a: &Attributes) -> Vec<String> {
+        [("diffuse", a.diffuse, self.diffuse), ("specular", a.specular, self.specular)]
+            .into_iter()
+            .filter_map(|(name, old, edit)| match edit {
+                Some(ColourEdit::Scale(s)) if s != 1.0 && old.iter().all(|&v| v < NO_ALBEDO) => {
+                    Some(format!(
+                        "the fit finds no {name} albedo ({:.4} {:.4} {:.4}), so scaling it \
+                         changes nothing; set it to a colour instead",
+                        old[0], old[1], old[2]
+                    ))
+                }
+                _ => None,
+            })
+            .collect()
+    }
+
     /// The edited attributes of `a`, checked.
     pub fn apply(&self, a: &Attributes) -> Result<Attributes> {
         let roughness = match self.roughness {
@@ -158,6 +181,22 @@ impl Edit {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn scaling_an_albedo_the_fit_lacks_is_named() {
+        let metal = Attributes { diffuse: [0.0; 3], specular: [0.5, 0.4, 0.2], roughness: 0.1 };
+        let halve = Edit { diffuse: Some(ColourEdit::Scale(0.5)), ..Edit::default() };
+        let notes = halve.without_effect(&metal);
+        assert_eq!(notes.len(), 1);
+        assert!(notes[0].contains("no diffuse albedo"), "{notes:?}");
+        // Setting it acts; scaling the specular acts; a plastic's diffuse acts.
+        let set = Edit { diffuse: Some(ColourEdit::Set([0.2; 3])), ..Edit::default() };
+        assert!(set.without_effect(&metal).is_empty());
+        let spec = Edit { specular: Some(ColourEdit::Scale(0.5)), ..Edit::default() };
+        assert!(spec.without_effect(&metal).is_empty());
+        let plastic = Attributes { diffuse: [0.3, 0.1, 0.1], ..metal };
+        assert!(halve.without_effect(&plastic).is_empty());
+    }
 
     #[test]
     fn an_attribute_is_set_or_scaled_not_both() {

@@ -81,6 +81,9 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     let original = editing::attributes_of(&table, &name, &fit)?;
     // Checked before the model loads: a bad value fails at once.
     edit.apply(&original).with_context(|| format!("editing {name}"))?;
+    for note in edit.without_effect(&original) {
+        eprintln!("warning: {name}: {note}");
+    }
     let (edited, by) = match mode.needs_network() {
         false => (edit_material(&table, &original, &edit, mode, None)?, "no network".to_string()),
         true => {
