@@ -230,9 +230,8 @@ fn vndf_table(ndf: &Marginal2D, theta_i: &[f32], side: usize) -> Vec<f32> {
                 })
                 .collect();
             let sum: f64 = slice.iter().sum();
-            let uniform = 1.0 / (side * side) as f64;
-            let share = UNIFORM_WARP_SHARE;
-            slice.iter_mut().for_each(|v| *v = (1.0 - share) * *v / sum + share * uniform);
+            let uniform = UNIFORM_WARP_SHARE / (side * side) as f64;
+            slice.iter_mut().for_each(|v| *v = (1.0 - UNIFORM_WARP_SHARE) * *v / sum + uniform);
             slice.into_iter().map(|v| v as f32)
         })
         .collect()
@@ -301,26 +300,16 @@ impl Slice {
     /// Gives each node below the horizon that borders a node above it the mean of those
     /// neighbours, so a cell the horizon crosses is not darkened towards zero.
     fn fill_horizon(&mut self, m: usize) {
-        let valid = self.valid.clone();
-        for i in 0..m * m {
-            if valid[i] {
-                continue;
-            }
+        let valid = &self.valid;
+        for i in (0..m * m).filter(|&i| !valid[i]) {
             let (row, col) = (i / m, i % m);
-            let mut near = Vec::with_capacity(4);
-            if row > 0 {
-                near.push(i - m);
-            }
-            if row + 1 < m {
-                near.push(i + m);
-            }
-            if col > 0 {
-                near.push(i - 1);
-            }
-            if col + 1 < m {
-                near.push(i + 1);
-            }
-            near.retain(|&j| valid[j]);
+            let sides = [
+                (row > 0).then(|| i - m),
+                (row + 1 < m).then(|| i + m),
+                (col > 0).then(|| i - 1),
+                (col + 1 < m).then(|| i + 1),
+            ];
+            let near: Vec<usize> = sides.into_iter().flatten().filter(|&j| valid[j]).collect();
             if near.is_empty() {
                 continue;
             }
