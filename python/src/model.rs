@@ -253,13 +253,14 @@ impl Model {
     }
 
     /// edit(table, *, diffuse=None, diffuse_scale=None, specular=None, specular_scale=None,
-    /// roughness=None, roughness_scale=None, mode="stretch") -> numpy.ndarray
+    /// roughness=None, roughness_scale=None, mode="parts") -> numpy.ndarray
     ///
     /// §5.1: the table with its diffuse albedo, specular albedo or roughness set (`diffuse=(r,
     /// g, b)`, `roughness=alpha`) or scaled (`*_scale=x`), as `experiments edit` does with the
-    /// same options. `mode`: `stretch` (default, no network: the table's own highlight stretched
-    /// to the new roughness, the albedos as `analytic`), `analytic` (no network: the fitted lobe
-    /// swapped), or through the model's regressor (eq. 7) and decoder: `residual` (`Y' = Y +
+    /// same options. `mode`: `parts` (default, no network: the table split into a floor, lobes,
+    /// a retro-reflective ridge and a sheen, each lobe stretched by its own roughness), `stretch`
+    /// (no network: the table's own highlight stretched to the new roughness, the albedos as
+    /// `analytic`), `analytic` (no network: the fitted lobe swapped), or through the model's regressor (eq. 7) and decoder: `residual` (`Y' = Y +
     /// Phi(alpha') - Phi(alpha)`), `paper` (`Y' = Phi(alpha')`), `transfer` (the residual edit's
     /// change carried onto the table).
     #[pyo3(signature = (table, *, diffuse=None, diffuse_scale=None, specular=None,

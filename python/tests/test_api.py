@@ -71,6 +71,8 @@ def test_edit_changes_the_attribute_asked_for(model, chrome):
     assert after[6] > 1.5 * before[6], (before, after)
     stretched = deepbrdf.attributes(model.edit(plastic, roughness_scale=2.0, mode="stretch"))
     assert stretched[6] > 1.5 * before[6], (before, stretched)
+    by_parts = deepbrdf.attributes(model.edit(plastic, roughness_scale=2.0))
+    assert by_parts[6] > 1.5 * before[6], (before, by_parts)
     with pytest.raises(ValueError, match="not both"):
         model.edit(chrome, roughness=0.1, roughness_scale=2)
     with pytest.raises(ValueError, match="edit mode"):

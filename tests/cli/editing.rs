@@ -123,7 +123,7 @@ fn train_a_regressor_edit_and_interpolate() {
         &["edit", "--model", &other, &m1, "--mode", "transfer", "-o", "x.binary"],
     );
     util::assert_clean_failure(&out, "train-regressor");
-    // A model given to the default (stretch) edit, which uses none: refused, naming the modes.
+    // A model given to the default (parts) edit, which uses none: refused, naming the modes.
     let out = util::run_in(dir.path(), &["edit", "--model", &model, &m1, "-o", "x.binary"]);
     util::assert_clean_failure(&out, "--mode residual");
     assert!(!dir.path().join("x.binary").exists());

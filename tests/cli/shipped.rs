@@ -37,9 +37,9 @@ fn the_shipped_model_encodes_decodes_edits_and_recovers_without_model_options() 
     let out = ok(&["edit", &m0, "--diffuse-scale", "0.5", "--mode", "residual", "-o", &s(&edited)]);
     assert!(util::stdout(&out).contains(&id), "{}", util::stdout(&out));
     assert!(read_merl(&edited).is_ok());
-    // Without --mode: the stretch edit, which needs no network.
+    // Without --mode: the parts edit, which needs no network.
     let out = ok(&["edit", &m0, "--roughness-scale", "0.5", "-o", &s(&edited), "--force"]);
-    assert!(util::stdout(&out).contains("no network, stretch edit"), "{}", util::stdout(&out));
+    assert!(util::stdout(&out).contains("no network, parts edit"), "{}", util::stdout(&out));
     assert!(read_merl(&edited).is_ok());
 
     // A photo of the material (a render over black), recovered with the shipped network.

@@ -9,6 +9,7 @@ pub mod deep;
 pub mod editing;
 pub mod error;
 pub mod figures;
+pub mod golden;
 pub mod harness;
 pub mod ipca;
 pub mod metrics;

@@ -16,6 +16,7 @@ pub mod interpolation;
 pub mod known;
 pub mod lobe;
 pub mod measures;
+pub mod parts;
 pub mod request;
 pub mod space;
 pub mod stretch;
@@ -37,3 +38,25 @@ pub use space::{
     DEFAULT_LATENT_MODE, DEFAULT_MODE,
 };
 pub use stretch::{stretch_edit, stretch_roughness};
+
+/// What the editing tests share.
+#[cfg(test)]
+pub(crate) mod testing {
+    use deepbrdf_data::merl::grid::cos_weights;
+    use deepbrdf_data::merl::CELLS;
+    use deepbrdf_data::MerlTable;
+
+    /// Cosine-weighted relative L1 distance of `a` from `b` over their valid cells.
+    pub fn distance(a: &MerlTable, b: &MerlTable) -> f64 {
+        let w = cos_weights();
+        let (mut num, mut den) = (0.0, 0.0);
+        for (n, (&x, &y)) in a.values().iter().zip(b.values()).enumerate() {
+            let cell = n % CELLS;
+            if x >= 0.0 && y >= 0.0 && w[cell] > 0.0 {
+                num += f64::from(w[cell]) * f64::from((x - y).abs());
+                den += f64::from(w[cell]) * f64::from(y.abs());
+            }
+        }
+        num / den
+    }
+}

@@ -30,9 +30,8 @@ use crate::error::{EvalError, Result};
 use deepbrdf_data::ggx::smith_g1;
 use deepbrdf_data::merl::coords::continuous_theta_h;
 use deepbrdf_data::merl::grid::{phi_d_of, theta_d_of, theta_h_of, ROW};
-use deepbrdf_data::merl::{cell_index, MerlTable, CELLS, INVALID_VALUE, N_PHI_D, N_THETA_H};
+use deepbrdf_data::merl::{cell_index, MerlTable, CELLS, N_PHI_D, N_THETA_H};
 use deepbrdf_render::Brdf;
-use rayon::prelude::*;
 use std::f64::consts::PI;
 
 /// `table` edited from its fitted attributes `fitted` to `requested`: the roughness by
@@ -71,59 +70,49 @@ pub fn stretch_roughness(
     let floor = fitted.diffuse.map(|d| (d / PI) as f32);
     let model = Attributes { roughness, ..*fitted }.brdf();
     let values = table.values();
-    let mut out = vec![INVALID_VALUE; values.len()];
-    // One theta_h row (all theta_d, phi_d) of the three channels per task: a row of cells is
-    // contiguous in each channel's plane, and rows are independent.
-    let (red, rest) = out.split_at_mut(CELLS);
-    let (green, blue) = rest.split_at_mut(CELLS);
-    red.par_chunks_mut(ROW)
-        .zip(green.par_chunks_mut(ROW))
-        .zip(blue.par_chunks_mut(ROW))
-        .enumerate()
-        .for_each(|(i, ((r, g), b))| {
-            let source = Source::new(i, s);
-            let mut planes = [r, g, b];
-            for jk in 0..ROW {
-                let (j, k) = (jk / N_PHI_D, jk % N_PHI_D);
-                let cell = cell_index(i, j, k);
-                let factor = source.factor(j, k, alpha, roughness);
-                // Where the table has nothing to stretch from, the fitted lobe at the new
-                // roughness, computed once per cell.
-                let mut analytic = None;
-                for (c, plane) in planes.iter_mut().enumerate() {
-                    let t = values[c * CELLS + cell];
-                    if t < 0.0 {
-                        continue; // stays invalid
-                    }
-                    let specular = factor
-                        .and_then(|f| source.specular(values, c, j, k, floor[c]).map(|v| f * v))
-                        .unwrap_or_else(|| {
-                            let lobe = analytic.get_or_insert_with(|| {
-                                let (wi, wo) = crate::attributes::cell_directions(cell);
-                                model.eval(wi, wo)
-                            });
-                            (lobe[c] - f64::from(floor[c])).max(0.0)
-                        });
-                    plane[jk] = t.min(floor[c]) + specular as f32;
+    // One theta_h row (all theta_d, phi_d) of the three channels per task.
+    MerlTable::from_par_rows(|i, mut planes| {
+        let source = Source::new(i, s);
+        for jk in 0..ROW {
+            let (j, k) = (jk / N_PHI_D, jk % N_PHI_D);
+            let cell = cell_index(i, j, k);
+            let factor = source.factor(j, k, alpha, roughness);
+            // Where the table has nothing to stretch from, the fitted lobe at the new
+            // roughness, computed once per cell.
+            let mut analytic = None;
+            for (c, plane) in planes.iter_mut().enumerate() {
+                let t = values[c * CELLS + cell];
+                if t < 0.0 {
+                    continue; // stays invalid
                 }
+                let specular = factor
+                    .and_then(|f| source.specular(values, c, j, k, floor[c]).map(|v| f * v))
+                    .unwrap_or_else(|| {
+                        let lobe = analytic.get_or_insert_with(|| {
+                            let (wi, wo) = crate::attributes::cell_directions(cell);
+                            model.eval(wi, wo)
+                        });
+                        (lobe[c] - f64::from(floor[c])).max(0.0)
+                    });
+                plane[jk] = t.min(floor[c]) + specular as f32;
             }
-        });
-    MerlTable::from_values(out)
-        .map_err(|e| EvalError::Invalid(format!("stretching the highlight: the edited table: {e}")))
+        }
+    })
+    .map_err(|e| EvalError::Invalid(format!("stretching the highlight: the edited table: {e}")))
 }
 
 /// Where theta_h bin `i` reads from in a stretch by `s`.
-struct Source {
+pub(crate) struct Source {
     theta_h: f64,
     theta_src: f64,
     /// `cos^4(theta_h') / (s^2 cos^4(theta_h))`.
     stretch: f64,
     /// The two theta_h bins around `theta_src` and the weight of the second.
-    bins: (usize, usize, f64),
+    pub(crate) bins: (usize, usize, f64),
 }
 
 impl Source {
-    fn new(i: usize, s: f64) -> Self {
+    pub(crate) fn new(i: usize, s: f64) -> Self {
         let theta_h = theta_h_of(i);
         let theta_src = (theta_h.tan() / s).atan();
         let stretch = (theta_src.cos() / theta_h.cos()).powi(4) / (s * s);
@@ -136,14 +125,26 @@ impl Source {
     /// The factor on the source's specular part at (theta_d bin `j`, phi_d bin `k`), or None
     /// where the source or the cell lies on or below the horizon.
     fn factor(&self, j: usize, k: usize, alpha: f64, roughness: f64) -> Option<f64> {
+        self.factor_with(smith_g1, j, k, alpha, roughness)
+    }
+
+    /// [`Self::factor`] with the masking `g1(alpha, cos)` of another distribution.
+    pub(crate) fn factor_with(
+        &self,
+        g1: impl Fn(f64, f64) -> f64,
+        j: usize,
+        k: usize,
+        alpha: f64,
+        roughness: f64,
+    ) -> Option<f64> {
         let (td, pd) = (theta_d_of(j), phi_d_of(k));
         let (ci, co) = cosines(self.theta_h, td, pd);
         let (si, so) = cosines(self.theta_src, td, pd);
         if ci <= 0.0 || co <= 0.0 || si <= 0.0 || so <= 0.0 {
             return None;
         }
-        let masking = smith_g1(roughness, ci) * smith_g1(roughness, co);
-        let masking_src = smith_g1(alpha, si) * smith_g1(alpha, so);
+        let masking = g1(roughness, ci) * g1(roughness, co);
+        let masking_src = g1(alpha, si) * g1(alpha, so);
         let f = self.stretch * masking * si * so / (masking_src * ci * co);
         f.is_finite().then_some(f)
     }
@@ -167,7 +168,7 @@ impl Source {
 
 /// `(cos theta_i, cos theta_o)` at half-vector angle `th` (phi_h = 0) and difference angles
 /// (`td`, `pd`) (Rusinkiewicz 1998; the expressions of `deepbrdf_data::merl::grid::cos_product`).
-fn cosines(th: f64, td: f64, pd: f64) -> (f64, f64) {
+pub(crate) fn cosines(th: f64, td: f64, pd: f64) -> (f64, f64) {
     let a = td.cos() * th.cos();
     let b = td.sin() * pd.cos() * th.sin();
     (a - b, a + b)
@@ -176,25 +177,12 @@ fn cosines(th: f64, td: f64, pd: f64) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::editing::testing::distance;
+    use deepbrdf_data::merl::INVALID_VALUE;
     use deepbrdf_data::merl::cell_coords;
-    use deepbrdf_data::merl::grid::cos_weights;
 
     fn attributes(roughness: f64) -> Attributes {
         Attributes { diffuse: [0.3, 0.2, 0.1], specular: [0.05, 0.04, 0.03], roughness }
-    }
-
-    /// Cosine-weighted relative L1 distance of two tables over their valid cells.
-    fn distance(a: &MerlTable, b: &MerlTable) -> f64 {
-        let w = cos_weights();
-        let (mut num, mut den) = (0.0, 0.0);
-        for (n, (&x, &y)) in a.values().iter().zip(b.values()).enumerate() {
-            let cell = n % CELLS;
-            if x >= 0.0 && y >= 0.0 && w[cell] > 0.0 {
-                num += f64::from(w[cell]) * f64::from((x - y).abs());
-                den += f64::from(w[cell]) * f64::from(y.abs());
-            }
-        }
-        num / den
     }
 
     /// A Lambertian + GGX metal (Schlick's Fresnel) narrowed and widened reflects what the model

@@ -10,6 +10,7 @@
 
 use crate::baseline::Domain;
 use crate::error::{EvalError, Result};
+use crate::golden::golden_section;
 use crate::ipca::{cosine_log_relative_eps, cosine_log_relative_inverse_eps, EPSILON};
 use crate::pca::LinearBasis;
 use deepbrdf_data::merl::{grid::cos_weights, CELLS};
@@ -224,25 +225,10 @@ fn minimise(cost: impl Fn(f64) -> f64, upper: f64) -> f64 {
             (best_x, best) = (x, f);
         }
     }
-    let (mut lo, mut hi) = ((best_x - step).max(0.0), (best_x + step).min(upper));
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
-    let (mut f1, mut f2) = (cost(x1), cost(x2));
-    for _ in 0..GOLDEN_STEPS {
-        if f1 < f2 {
-            (hi, x2, f2) = (x2, x1, f1);
-            x1 = hi - g * (hi - lo);
-            f1 = cost(x1);
-        } else {
-            (lo, x1, f1) = (x1, x2, f2);
-            x2 = lo + g * (hi - lo);
-            f2 = cost(x2);
-        }
-    }
-    for (x, f) in [(x1, f1), (x2, f2)] {
-        if f < best {
-            (best_x, best) = (x, f);
-        }
+    let (lo, hi) = ((best_x - step).max(0.0), (best_x + step).min(upper));
+    let (x, f) = golden_section(cost, lo, hi, GOLDEN_STEPS);
+    if f < best {
+        best_x = x;
     }
     best_x
 }

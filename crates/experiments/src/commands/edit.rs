@@ -1,9 +1,10 @@
 //! `experiments edit [--model DIR] MATERIAL [--diffuse R,G,B | --diffuse-scale X] [--specular
 //! R,G,B | --specular-scale X] [--roughness X | --roughness-scale X]
-//! [--mode paper|residual|transfer|analytic|stretch] -o edited.binary [--render edited.png]`: edits a
-//! material's diffuse albedo, specular albedo or roughness (§5.1) through the model's regressor
-//! (eq. 7) and decoder (eq. 3), or without a network (analytic, stretch), writes the edited MERL
-//! table, and prints the attributes asked for and those re-estimated on the result.
+//! [--mode paper|residual|transfer|analytic|stretch|parts] -o edited.binary [--render edited.png]`:
+//! edits a material's diffuse albedo, specular albedo or roughness (§5.1) through the model's
+//! regressor (eq. 7) and decoder (eq. 3), or without a network (analytic, stretch, parts), writes
+//! the edited MERL table, and prints the attributes asked for and those re-estimated on the
+//! result.
 use crate::args::data::CacheArg;
 use crate::args::edit::EditArgs;
 use crate::args::scene::SceneArgs;
@@ -29,8 +30,10 @@ pub struct Args {
     /// paper: Y' = Phi(alpha'); residual: Y' = Y + Phi(alpha') - Phi(alpha); transfer: the
     /// residual edit's change carried onto the table itself; analytic: the table's fitted
     /// Lambertian + GGX model swapped for the edited one, no network; stretch: the table's own
-    /// highlight stretched to the new roughness and the albedos edited as analytic, no network
-    /// [default: stretch].
+    /// highlight stretched to the new roughness and the albedos edited as analytic, no network;
+    /// parts: the table split into a diffuse floor, up to two lobes, a retro-reflective ridge
+    /// and a sheen, each lobe stretched by its own roughness, the floor and the lobes scaled by
+    /// the albedo edits, no network [default: parts].
     #[arg(long, value_parser = editing::mode_parser(&EditMode::ALL))]
     pub mode: Option<EditMode>,
     /// Output MERL .binary file.
@@ -101,6 +104,12 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
     println!("  original  {}", describe(&original));
     println!("  requested {}", describe(&edited.requested));
     println!("  achieved  {} (re-estimated on the result)", describe(&achieved));
+    if let Some(parts) = &edited.parts {
+        println!("  parts (fitted to the original):");
+        for line in parts.describe().lines() {
+            println!("    {line}");
+        }
+    }
     if let (Some(png), Some(setup)) = (&args.render, &setup) {
         let image = render(&setup.scene, &MerlBrdf::new(&edited.table), &setup.settings, progress)?;
         image.write_png(png, &setup.tonemap)?;

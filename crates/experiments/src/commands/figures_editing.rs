@@ -24,7 +24,7 @@
 //!
 //! Writes `results.md` (the tables), `suite.csv` (every material and edit) and the figures.
 use crate::args::data::DataArgs;
-use crate::editing::{self, EditMode, EditorArg, ModelCodec, Space};
+use crate::editing::{self, EditMode, EditorArg, ModelCodec, Space, DEFAULT_MODE};
 use anyhow::Context;
 use deepbrdf_data::dataset::{DataSource, Dataset};
 use deepbrdf_data::{MerlTable, Progress};
@@ -164,7 +164,7 @@ impl Figures<'_> {
             .collect();
         let reference = ImageRelae::new(&self.set.tables[g], &ImageRelaeConfig::default())?;
         let mut rows = Vec::new();
-        for mode in [EditMode::Paper, EditMode::Residual, EditMode::Stretch] {
+        for mode in [EditMode::Paper, EditMode::Residual, DEFAULT_MODE] {
             let mut tables = vec![self.set.tables[g].clone()];
             tables.extend(sweep(self.deep, &self.set.tables[g], &self.attrs[g], &edits, mode)?);
             let images = interpolation::render_all(&reference, &tables)?;
@@ -183,8 +183,9 @@ impl Figures<'_> {
         sheet.write_figure(&self.out.join("fig12_diffuse.jpg"))?;
         let _ = write!(
             md,
-            "\n## Fig. 12: diffuse albedo of gray-plastic\n\n![Fig. 12](fig12_diffuse.jpg)\n\n{}\n\nRows: the paper's edit, the residual edit (DeepBRDF), the stretch edit (no network: the diffuse albedo as the analytic edit sets it); first column the measurement. Requested vs re-estimated diffuse albedo:\n\n| edit | requested | paper: achieved | residual: achieved | stretch: achieved |\n| --- | --- | --- | --- | --- |\n",
-            figure_caption(&self.figure, noise)
+            "\n## Fig. 12: diffuse albedo of gray-plastic\n\n![Fig. 12](fig12_diffuse.jpg)\n\n{}\n\nRows: the paper's edit, the residual edit (DeepBRDF), the default edit without a network ({default}); first column the measurement. Requested vs re-estimated diffuse albedo:\n\n| edit | requested | paper: achieved | residual: achieved | {default}: achieved |\n| --- | --- | --- | --- | --- |\n",
+            figure_caption(&self.figure, noise),
+            default = DEFAULT_MODE.name()
         );
         for (i, (name, c)) in colours.iter().enumerate() {
             let got: Vec<String> = rows
@@ -230,12 +231,12 @@ impl Figures<'_> {
             let edits: Vec<Edit> = usable.iter().map(|(_, e)| *e).collect();
             let reference = ImageRelae::new(&self.set.tables[m], &ImageRelaeConfig::default())?;
             let mut rows = Vec::new();
-            // Each representation's paper and residual edits, then the stretch edit (no
+            // Each representation's paper and residual edits, then the default edit (no
             // network) once.
             let runs = methods
                 .iter()
                 .flat_map(|rep| [(*rep, EditMode::Paper), (*rep, EditMode::Residual)])
-                .chain([(self.deep, EditMode::Stretch)]);
+                .chain([(self.deep, DEFAULT_MODE)]);
             for (rep, mode) in runs {
                 let rep_name = if mode.needs_network() { rep.name } else { "-" };
                 let tables = sweep(rep, &self.set.tables[m], a, &edits, mode)?;

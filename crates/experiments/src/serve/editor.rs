@@ -21,6 +21,7 @@ use deepbrdf_data::dataset::load_bundled_material;
 use deepbrdf_data::merl::{merl_bytes, MerlFile};
 use deepbrdf_data::{MerlTable, Silent};
 use deepbrdf_eval::attributes::{Attributes, FitConfig};
+use deepbrdf_eval::editing::parts::{fit_parts, Parts, PartsConfig};
 use deepbrdf_model::regressor::Regressor;
 use deepbrdf_model::DeepBrdf;
 use deepbrdf_render::{
@@ -29,7 +30,7 @@ use deepbrdf_render::{
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Arc, Condvar, Mutex};
+use std::sync::{Arc, Condvar, Mutex, OnceLock};
 use std::time::Instant;
 use tokio::sync::oneshot;
 
@@ -185,9 +186,20 @@ struct Material {
     latent: Vec<f32>,
     /// The table sampler built from its values (shared by the fast previews of its edits).
     sampling: MerlSampling,
+    /// Its parts, fitted on its first parts edit and kept for the next.
+    parts: OnceLock<Parts>,
 }
 
 impl Material {
+    /// The table's parts ([`deepbrdf_eval::editing::parts`]).
+    fn parts(&self) -> Result<&Parts, Failure> {
+        if let Some(p) = self.parts.get() {
+            return Ok(p);
+        }
+        let fitted = fit_parts(&self.table, &PartsConfig::default())?.parts;
+        Ok(self.parts.get_or_init(|| fitted))
+    }
+
     fn info(&self) -> MaterialInfo {
         MaterialInfo {
             id: self.id.clone(),
@@ -303,7 +315,9 @@ impl Editor {
         let attributes = editing::attributes_of(&table, &name, &FitConfig::default())?;
         let latent = self.model.encode(&table).map_err(internal)?;
         let sampling = MerlBrdf::new(&table).sampling().clone();
-        let m = Arc::new(Material { id: id.clone(), name, table, attributes, latent, sampling });
+        let parts = OnceLock::new();
+        let m =
+            Arc::new(Material { id: id.clone(), name, table, attributes, latent, sampling, parts });
         self.materials.put(id, m.clone());
         Ok(m)
     }

@@ -7,6 +7,7 @@
 
 use super::{albedo_error, albedos, distances, KnownEdit};
 use crate::attributes::{self, Attributes, FitConfig};
+use crate::editing::parts::{fit_parts, parts_edit, Parts, PartsConfig};
 use crate::editing::{
     judge_edit, stretch_edit, ColourEdit, Edit, EditMode, Lobe, ScalarEdit, Space,
 };
@@ -36,6 +37,8 @@ pub enum KnownMethod {
     DeepbrdfTransferPaper,
     /// IPCA's residual edit carried onto the table.
     IpcaTransfer,
+    /// The parts edit, no network ([`crate::editing::parts`]).
+    Parts,
     /// The stretch edit on Sun et al. 2018's diffuse-specular split
     /// ([`crate::separation::separated_attributes`]).
     Sun2018Stretch,
@@ -44,6 +47,7 @@ pub enum KnownMethod {
 deepbrdf_data::named_enum!(KnownMethod {
     Analytic => "analytic",
     Stretch => "stretch",
+    Parts => "parts",
     DeepbrdfResidual => "deepbrdf-residual",
     DeepbrdfPaper => "deepbrdf-paper",
     IpcaResidual => "ipca-residual",
@@ -85,6 +89,7 @@ impl KnownMethod {
         match self {
             Self::Analytic => EditMode::Analytic,
             Self::Stretch | Self::Sun2018Stretch => EditMode::Stretch,
+            Self::Parts => EditMode::Parts,
             Self::DeepbrdfResidual | Self::IpcaResidual => EditMode::Residual,
             Self::DeepbrdfPaper | Self::DeepbrdfTransferPaper => EditMode::Paper,
             Self::DeepbrdfTransfer | Self::IpcaTransfer => EditMode::Transfer,
@@ -96,6 +101,7 @@ impl KnownMethod {
         match self {
             Self::Analytic => "analytic",
             Self::Stretch => "stretch",
+            Self::Parts => "parts",
             Self::DeepbrdfResidual => "DeepBRDF residual",
             Self::DeepbrdfPaper => "DeepBRDF paper",
             Self::IpcaResidual => "IPCA residual",
@@ -251,6 +257,7 @@ struct Subject<'a> {
     deep_latent: Option<Vec<f32>>,
     ipca_latent: Option<Vec<f32>>,
     split: Option<Attributes>,
+    parts: Option<Parts>,
     lobe: Option<Lobe>,
 }
 
@@ -272,6 +279,10 @@ impl<'a> Subject<'a> {
             deep_latent: latent(&input.deepbrdf, wants(KnownMethod::deepbrdf))?,
             ipca_latent: latent(&input.ipca, wants(KnownMethod::ipca))?,
             split: input.separation.map(|b| separated_attributes(b, table, fitted)),
+            parts: match wants(|m| m == KnownMethod::Parts) {
+                true => Some(fit_parts(table, &PartsConfig::default())?.parts),
+                false => None,
+            },
             lobe: Lobe::of(table).ok(),
         })
     }
@@ -280,6 +291,18 @@ impl<'a> Subject<'a> {
     fn edit(&self, method: KnownMethod, case: &Case) -> Result<MerlTable> {
         let (table, fitted) = (self.table, self.fitted);
         let missing = || EvalError::Invalid(format!("the {} edit's representation", method.name()));
+        if method == KnownMethod::Parts {
+            // The recolour rotates the floor's albedo, the parts' diffuse.
+            let parts = self.parts.as_ref().ok_or_else(missing)?;
+            let (start, edit) = match case.name {
+                RECOLOUR => {
+                    let start = Attributes { diffuse: parts.floor.albedo, ..*fitted };
+                    (start, Edit::rotated_diffuse(start.diffuse))
+                }
+                _ => (*fitted, case.edit),
+            };
+            return parts_edit(table, parts, &start, &edit.apply(&start)?);
+        }
         if method == KnownMethod::Sun2018Stretch {
             let split = self.split.as_ref().ok_or_else(missing)?;
             let edit = match case.name {

@@ -135,7 +135,7 @@ impl<'a> Material<'a> {
         let split = input.separation.map(|b| separated_attributes(b, table, original));
         for (edit_name, edit) in suite_edits(original) {
             let Ok(requested) = edit.apply(original) else { continue };
-            for mode in [EditMode::Analytic, EditMode::Stretch] {
+            for mode in [EditMode::Analytic, EditMode::Stretch, EditMode::Parts] {
                 let edited = mode.edit_without_network(table, original, &requested)?;
                 self.push(
                     suite,
@@ -240,7 +240,11 @@ mod tests {
         };
         let suite = run(&input, &Silent).unwrap();
         assert_eq!(suite.materials, 2);
-        assert_eq!(suite.rows.len(), 2 * EDITS.len() * 2, "two materials, analytic and stretch");
+        assert_eq!(
+            suite.rows.len(),
+            2 * EDITS.len() * 3,
+            "two materials, analytic, stretch, parts"
+        );
         let materials: Vec<&str> = suite.rows.iter().map(|r| r.material.as_str()).collect();
         assert!(materials.iter().all(|m| ["plastic", "grey"].contains(m)), "{materials:?}");
         for row in suite.rows.iter().filter(|r| r.edit == IDENTITY) {
@@ -252,6 +256,13 @@ mod tests {
         assert_eq!(report::csv(&suite.rows).lines().count(), 1 + suite.rows.len());
         let summary = report::outcome_summary(&suite.rows);
         assert!(summary.contains("| stretch | roughness x2 | - |"), "{summary}");
+        assert!(summary.contains("| parts | roughness x2 | - |"), "{summary}");
+        // Every parts edit of these Lambertian + GGX tables halves the diffuse floor as asked.
+        let parts = suite.rows.iter().filter(|r| r.method == "parts" && r.edit == "diffuse x0.5");
+        for row in parts {
+            let floor = row.lobe.as_ref().unwrap().comparison.floor_ratio;
+            assert!((0.45..0.55).contains(&floor), "parts: the diffuse floor x{floor}");
+        }
         let bad = SuiteInput { every: 0, ..input };
         assert!(run(&bad, &Silent).is_err());
     }

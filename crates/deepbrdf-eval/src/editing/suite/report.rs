@@ -67,9 +67,9 @@ pub fn lobe_summary(rows: &[SuiteRow]) -> String {
 
 /// The suite's (representation, mode) pairs, in the order of its tables: each representation's
 /// paper and residual edits and the residual edit carried onto the table (`Space::transfer`),
-/// and the edits without a network: analytic, stretch, and stretch on Sun et al. 2018's split
-/// (where the suite is given the separation's data).
-pub const SUITE_METHODS: [(&str, &str); 9] = [
+/// and the edits without a network: analytic, stretch, parts, and stretch on Sun et al. 2018's
+/// split (where the suite is given the separation's data).
+pub const SUITE_METHODS: [(&str, &str); 10] = [
     ("DeepBRDF", "paper"),
     ("DeepBRDF", "residual"),
     ("DeepBRDF", "transfer"),
@@ -78,6 +78,7 @@ pub const SUITE_METHODS: [(&str, &str); 9] = [
     ("IPCA", "transfer"),
     ("analytic", "-"),
     ("stretch", "-"),
+    ("parts", "-"),
     (SEPARATED, "-"),
 ];
 
@@ -117,7 +118,7 @@ pub fn csv(rows: &[SuiteRow]) -> String {
 /// edit's mean image RelAE and the plausible tables (columns as `figures-editing` heads them).
 pub fn outcome_summary(rows: &[SuiteRow]) -> String {
     let mut md = String::new();
-    for method in ["DeepBRDF", "IPCA", "analytic", "stretch", SEPARATED] {
+    for method in ["DeepBRDF", "IPCA", "analytic", "stretch", "parts", SEPARATED] {
         for edit_name in EDITS {
             for (_, mode) in SUITE_METHODS.into_iter().filter(|(m, _)| *m == method) {
                 let sel: Vec<&SuiteRow> = rows

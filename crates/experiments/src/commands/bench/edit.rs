@@ -2,7 +2,9 @@
 //! §5.1 (target: <= 0.5 s on 2 cores), split into the regressor (eq. 7, twice for the residual
 //! edit), the decode (eq. 3) and a 128-pixel preview render (sphere, sun and sky, 16 spp); the
 //! attribute fit and the encode of the material, done once when it is picked, are timed apart.
-//! Without an edit option the edit is roughness x0.5.
+//! The edits of the table itself (no network: stretch, and parts with its fit of the material's
+//! parts, done once per material) are timed too. Without an edit option the edit is roughness
+//! x0.5.
 use crate::args::data::CacheArg;
 use crate::args::edit::EditArgs;
 use crate::editing::{self, EditMode, EditorArg, ModelCodec, Space, DEFAULT_LATENT_MODE};
@@ -10,7 +12,8 @@ use anyhow::Context;
 use deepbrdf_data::dataset::load_material;
 use deepbrdf_data::{Progress, Silent};
 use deepbrdf_eval::attributes::FitConfig;
-use deepbrdf_eval::editing::{Edit, ScalarEdit};
+use deepbrdf_eval::editing::parts::{fit_parts, parts_edit, PartsConfig};
+use deepbrdf_eval::editing::{stretch_edit, Edit, ScalarEdit};
 use deepbrdf_eval::harness::Codec;
 use deepbrdf_eval::metrics::ImageRelaeConfig;
 use deepbrdf_eval::stats::finite_median;
@@ -89,6 +92,27 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         finite_median(dec),
         finite_median(ren)
     );
-    println!("once per material: attribute fit {fit:.3} s, encode {encode:.3} s; loading model and regressor {load:.2} s");
+    // The table edits, without a network.
+    let t = Instant::now();
+    let parts = fit_parts(&table, &PartsConfig::default())?.parts;
+    let parts_fit = t.elapsed().as_secs_f64();
+    let requested = edit.apply(&original)?;
+    let (mut stretch, mut by_parts) = (Vec::new(), Vec::new());
+    for rep in 0..=args.reps.max(1) {
+        let t0 = Instant::now();
+        let _ = stretch_edit(&table, &original, &requested)?;
+        let t1 = Instant::now();
+        let _ = parts_edit(&table, &parts, &original, &requested)?;
+        if rep > 0 {
+            stretch.push((t1 - t0).as_secs_f64());
+            by_parts.push(t1.elapsed().as_secs_f64());
+        }
+    }
+    println!(
+        "table edits (no network, no preview): stretch {:.3} s, parts {:.3} s",
+        finite_median(stretch),
+        finite_median(by_parts)
+    );
+    println!("once per material: attribute fit {fit:.3} s, parts fit {parts_fit:.3} s, encode {encode:.3} s; loading model and regressor {load:.2} s");
     Ok(())
 }

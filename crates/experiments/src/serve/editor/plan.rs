@@ -1,13 +1,14 @@
 //! What the editor makes of an edit request (§5.1): its [`Plan`] (the material or blend it
 //! starts from, the attributes asked for and, for the modes that edit the latent, the edited
 //! latent), then the edited table: the decoded latent (kept per latent), or the table edited
-//! itself by the other modes (transfer, analytic, stretch; kept per edit).
+//! itself by the other modes (transfer, analytic, stretch, parts; kept per edit).
 use super::{Editor, Material};
 use crate::editing::{self, EditMode, ModelCodec, Space};
 use crate::serve::replies::{internal, Failure};
 use crate::serve::request::{CheckedEdit, Refusal};
 use deepbrdf_data::MerlTable;
 use deepbrdf_eval::attributes::Attributes;
+use deepbrdf_eval::editing::parts::parts_edit;
 use std::sync::Arc;
 
 /// An edit worked out up to its table.
@@ -80,8 +81,14 @@ impl Editor {
         let codec = ModelCodec(&self.model);
         let space = Space { codec: &codec, regressor: &self.regressor };
         let table = blended.as_ref().unwrap_or(&plan.material.table);
-        let edited = space.edit(table, &plan.start, &plan.base, &edit.edit, edit.mode)?;
-        let table = Arc::new(edited.table);
+        let edited = match (edit.mode, &blended) {
+            // A material's parts are fitted once and kept.
+            (EditMode::Parts, None) => {
+                parts_edit(table, plan.material.parts()?, &plan.base, &plan.requested)?
+            }
+            _ => space.edit(table, &plan.start, &plan.base, &edit.edit, edit.mode)?.table,
+        };
+        let table = Arc::new(edited);
         self.edited.put(key, table.clone());
         Ok(table)
     }
