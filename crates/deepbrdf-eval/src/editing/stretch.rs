@@ -178,8 +178,8 @@ pub(crate) fn cosines(th: f64, td: f64, pd: f64) -> (f64, f64) {
 mod tests {
     use super::*;
     use crate::editing::testing::distance;
-    use deepbrdf_data::merl::INVALID_VALUE;
     use deepbrdf_data::merl::cell_coords;
+    use deepbrdf_data::merl::INVALID_VALUE;
 
     fn attributes(roughness: f64) -> Attributes {
         Attributes { diffuse: [0.3, 0.2, 0.1], specular: [0.05, 0.04, 0.03], roughness }
