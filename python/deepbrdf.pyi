@@ -138,7 +138,7 @@ class Model:
         mode: Optional[str] = None,
     ) -> Table:
         """§5.1: set or scale the diffuse albedo, specular albedo or roughness, as
-        `experiments edit`; `mode`: parts (default, no network), stretch, residual, paper, transfer or
+        `experiments edit`; `mode`: parts (default, no network), stretch, residual, paper, nearest, transfer or
         analytic."""
     def interpolate(self, a: ArrayLike, b: ArrayLike, steps: int = 9) -> npt.NDArray[np.float32]:
         """Fig. 10's latent path from `a` to `b`: (steps, 3, 90, 90, 180)."""

@@ -62,7 +62,7 @@ fn corpus_training_and_known_answer_edits() {
         "--out",
         &s(&out),
         "--methods",
-        "analytic,stretch,parts,deepbrdf-residual,deepbrdf-paper,ipca-residual,deepbrdf-transfer,deepbrdf-transfer-paper,ipca-transfer,sun2018-stretch",
+        "analytic,stretch,parts,deepbrdf-residual,deepbrdf-paper,deepbrdf-nearest,ipca-residual,deepbrdf-transfer,deepbrdf-transfer-paper,ipca-transfer,sun2018-stretch",
     ]));
     assert!(printed.contains("| analytic | **all** |"), "{printed}");
     let csv = std::fs::read_to_string(out.join("known.csv")).unwrap();
@@ -73,6 +73,7 @@ fn corpus_training_and_known_answer_edits() {
         "parts",
         "DeepBRDF residual",
         "DeepBRDF paper",
+        "DeepBRDF nearest",
         "IPCA residual",
         "DeepBRDF transfer",
         "DeepBRDF transfer (paper)",

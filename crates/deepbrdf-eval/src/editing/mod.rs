@@ -16,6 +16,7 @@ pub mod interpolation;
 pub mod known;
 pub mod lobe;
 pub mod measures;
+pub mod nearest;
 pub mod parts;
 pub mod request;
 pub mod space;

@@ -5,6 +5,7 @@
 //! path, two tables).
 
 use crate::attributes::Attributes;
+use crate::editing::nearest::AttributePredictor;
 use crate::editing::parts::{fit_parts, parts_edit, Parts, PartsConfig};
 use crate::editing::{analytic_edit, carry_edit, stretch_edit, Edit};
 use crate::error::{EvalError, Result};
@@ -23,6 +24,9 @@ pub enum EditMode {
     Paper,
     /// Keeps what the attributes do not explain: `Y' = Y + Phi(alpha') - Phi(alpha)`.
     Residual,
+    /// The latent nearest the material's that a linear latent-to-attribute predictor reads as
+    /// the request ([`crate::editing::nearest`]).
+    Nearest,
     /// The residual edit's change `D(Y) -> D(Y')` carried onto the table itself
     /// ([`Space::transfer`]): what the representation does not reconstruct is kept.
     Transfer,
@@ -39,22 +43,24 @@ pub enum EditMode {
 
 impl EditMode {
     /// Every mode.
-    pub const ALL: [EditMode; 6] = [
+    pub const ALL: [EditMode; 7] = [
         EditMode::Paper,
         EditMode::Residual,
+        EditMode::Nearest,
         EditMode::Transfer,
         EditMode::Analytic,
         EditMode::Stretch,
         EditMode::Parts,
     ];
     /// The modes whose result is a latent, decoded as it is (the browser editor's).
-    pub const LATENT: [EditMode; 2] = [EditMode::Paper, EditMode::Residual];
+    pub const LATENT: [EditMode; 3] = [EditMode::Paper, EditMode::Residual, EditMode::Nearest];
 
     /// The mode's name on the command line and in results.
     pub fn name(self) -> &'static str {
         match self {
             Self::Paper => "paper",
             Self::Residual => "residual",
+            Self::Nearest => "nearest",
             Self::Transfer => "transfer",
             Self::Analytic => "analytic",
             Self::Stretch => "stretch",
@@ -64,7 +70,7 @@ impl EditMode {
 
     /// Whether the edit needs the table's latent (its encoding).
     pub fn needs_latent(self) -> bool {
-        matches!(self, Self::Residual | Self::Transfer)
+        matches!(self, Self::Residual | Self::Transfer | Self::Nearest)
     }
 
     /// Whether the edit goes through a representation and its regressor.
@@ -87,7 +93,7 @@ impl EditMode {
                 let parts = fit_parts(table, &PartsConfig::default())?.parts;
                 parts_edit(table, &parts, original, requested)
             }
-            Self::Paper | Self::Residual | Self::Transfer => {
+            Self::Paper | Self::Residual | Self::Transfer | Self::Nearest => {
                 Err(EvalError::Invalid(format!("the {self} edit needs a model and its regressor")))
             }
         }
@@ -180,7 +186,7 @@ impl Space<'_> {
     ) -> Result<Edited> {
         let requested = edit.apply(original)?;
         let table = match mode {
-            EditMode::Paper | EditMode::Residual => {
+            EditMode::Paper | EditMode::Residual | EditMode::Nearest => {
                 self.codec.decode(&self.edited_latent(latent, original, &requested, mode)?)?
             }
             EditMode::Transfer => return self.transfer(table, latent, original, edit, mode),
@@ -228,13 +234,16 @@ impl Space<'_> {
         requested: &Attributes,
         mode: EditMode,
     ) -> Result<Vec<f32>> {
+        if mode == EditMode::Nearest {
+            return AttributePredictor::of(self.regressor)?.nearest(latent, requested);
+        }
         let target = self.latent_of(requested)?;
         Ok(match mode {
             EditMode::Paper => target,
             EditMode::Analytic | EditMode::Stretch | EditMode::Parts => {
                 return Err(EvalError::Invalid(format!("the {mode} edit has no latent")));
             }
-            EditMode::Residual | EditMode::Transfer => {
+            EditMode::Residual | EditMode::Transfer | EditMode::Nearest => {
                 let base = self.latent_of(original)?;
                 latent.iter().zip(target.iter().zip(&base)).map(|(y, (t, b))| y + t - b).collect()
             }

@@ -1,6 +1,7 @@
 //! `experiments edit [--model DIR] MATERIAL [--diffuse R,G,B | --diffuse-scale X] [--specular
 //! R,G,B | --specular-scale X] [--roughness X | --roughness-scale X]
-//! [--mode paper|residual|transfer|analytic|stretch|parts] -o edited.binary [--render edited.png]`:
+//! [--mode paper|residual|nearest|transfer|analytic|stretch|parts] -o edited.binary
+//! [--render edited.png]`:
 //! edits a material's diffuse albedo, specular albedo or roughness (§5.1) through the model's
 //! regressor (eq. 7) and decoder (eq. 3), or without a network (analytic, stretch, parts), writes
 //! the edited MERL table, and prints the attributes asked for and those re-estimated on the
@@ -27,7 +28,8 @@ pub struct Args {
     pub material: String,
     #[command(flatten)]
     pub edit: EditArgs,
-    /// paper: Y' = Phi(alpha'); residual: Y' = Y + Phi(alpha') - Phi(alpha); transfer: the
+    /// paper: Y' = Phi(alpha'); residual: Y' = Y + Phi(alpha') - Phi(alpha); nearest: the
+    /// latent nearest Y that a linear latent-to-attribute predictor reads as alpha'; transfer: the
     /// residual edit's change carried onto the table itself; analytic: the table's fitted
     /// Lambertian + GGX model swapped for the edited one, no network; stretch: the table's own
     /// highlight stretched to the new roughness and the albedos edited as analytic, no network;

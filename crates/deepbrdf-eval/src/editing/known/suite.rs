@@ -29,6 +29,8 @@ pub enum KnownMethod {
     DeepbrdfResidual,
     /// DeepBRDF's edit of the paper.
     DeepbrdfPaper,
+    /// DeepBRDF's nearest latent edit ([`crate::editing::nearest`]).
+    DeepbrdfNearest,
     /// IPCA's residual edit.
     IpcaResidual,
     /// DeepBRDF's residual edit carried onto the table ([`Space::transfer`]).
@@ -50,6 +52,7 @@ deepbrdf_data::named_enum!(KnownMethod {
     Parts => "parts",
     DeepbrdfResidual => "deepbrdf-residual",
     DeepbrdfPaper => "deepbrdf-paper",
+    DeepbrdfNearest => "deepbrdf-nearest",
     IpcaResidual => "ipca-residual",
     DeepbrdfTransfer => "deepbrdf-transfer",
     DeepbrdfTransferPaper => "deepbrdf-transfer-paper",
@@ -79,6 +82,7 @@ impl KnownMethod {
             self,
             Self::DeepbrdfResidual
                 | Self::DeepbrdfPaper
+                | Self::DeepbrdfNearest
                 | Self::DeepbrdfTransfer
                 | Self::DeepbrdfTransferPaper
         )
@@ -92,6 +96,7 @@ impl KnownMethod {
             Self::Parts => EditMode::Parts,
             Self::DeepbrdfResidual | Self::IpcaResidual => EditMode::Residual,
             Self::DeepbrdfPaper | Self::DeepbrdfTransferPaper => EditMode::Paper,
+            Self::DeepbrdfNearest => EditMode::Nearest,
             Self::DeepbrdfTransfer | Self::IpcaTransfer => EditMode::Transfer,
         }
     }
@@ -104,6 +109,7 @@ impl KnownMethod {
             Self::Parts => "parts",
             Self::DeepbrdfResidual => "DeepBRDF residual",
             Self::DeepbrdfPaper => "DeepBRDF paper",
+            Self::DeepbrdfNearest => "DeepBRDF nearest",
             Self::IpcaResidual => "IPCA residual",
             Self::DeepbrdfTransfer => "DeepBRDF transfer",
             Self::DeepbrdfTransferPaper => "DeepBRDF transfer (paper)",

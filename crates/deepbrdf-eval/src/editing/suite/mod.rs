@@ -122,7 +122,8 @@ impl<'a> Material<'a> {
         let (table, original) = (self.table, self.original);
         for rep in input.representations {
             let latent = rep.space.codec.encode(table)?;
-            for mode in [EditMode::Paper, EditMode::Residual, EditMode::Transfer] {
+            for mode in [EditMode::Paper, EditMode::Residual, EditMode::Nearest, EditMode::Transfer]
+            {
                 for (edit_name, edit) in suite_edits(original) {
                     let Ok(edited) = rep.space.edit(table, &latent, original, &edit, mode) else {
                         continue; // an edit out of range for this material (e.g. x2 past alpha 1)

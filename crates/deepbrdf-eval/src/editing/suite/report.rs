@@ -66,15 +66,18 @@ pub fn lobe_summary(rows: &[SuiteRow]) -> String {
 }
 
 /// The suite's (representation, mode) pairs, in the order of its tables: each representation's
-/// paper and residual edits and the residual edit carried onto the table (`Space::transfer`),
+/// paper, residual and nearest latent edits and the residual edit carried onto the table
+/// (`Space::transfer`),
 /// and the edits without a network: analytic, stretch, parts, and stretch on Sun et al. 2018's
 /// split (where the suite is given the separation's data).
-pub const SUITE_METHODS: [(&str, &str); 10] = [
+pub const SUITE_METHODS: [(&str, &str); 12] = [
     ("DeepBRDF", "paper"),
     ("DeepBRDF", "residual"),
+    ("DeepBRDF", "nearest"),
     ("DeepBRDF", "transfer"),
     ("IPCA", "paper"),
     ("IPCA", "residual"),
+    ("IPCA", "nearest"),
     ("IPCA", "transfer"),
     ("analytic", "-"),
     ("stretch", "-"),
