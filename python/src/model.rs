@@ -262,9 +262,9 @@ impl Model {
     /// (no network: the table's own highlight stretched to the new roughness, the albedos as
     /// `analytic`), `analytic` (no network: the fitted lobe swapped), or through the model's
     /// regressor (eq. 7) and decoder: `residual` (`Y' = Y + Phi(alpha') - Phi(alpha)`), `paper`
-    /// (`Y' = Phi(alpha')`), `nearest` (the latent nearest `Y` that a linear latent-to-attribute
-    /// predictor reads as `alpha'`), `transfer` (the residual edit's change carried onto the
-    /// table).
+    /// (`Y' = Phi(alpha')`), `nearest` (the latent nearest `Y` whose attributes, as a linear
+    /// latent-to-attribute predictor reads them, change by `alpha' - alpha`), `transfer` (the
+    /// residual edit's change carried onto the table).
     #[pyo3(signature = (table, *, diffuse=None, diffuse_scale=None, specular=None,
         specular_scale=None, roughness=None, roughness_scale=None, mode=None))]
     #[allow(clippy::too_many_arguments)]

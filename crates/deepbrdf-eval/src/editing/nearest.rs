@@ -1,8 +1,10 @@
 //! The nearest latent edit: the latent route of editing by optimisation. Where the paper's edit
 //! replaces the latent by the regressor's `Phi(alpha')` (eq. 7) and the residual edit adds
 //! `Phi(alpha') - Phi(alpha)`, this edit looks for the latent closest to the material's own
-//! whose attributes, as a differentiable latent-to-attribute predictor reads them, are the ones
-//! asked: `z' = argmin |z' - z|` subject to `P(z') = alpha'`. Every `z'` decodes to a table of
+//! whose attributes, as a differentiable latent-to-attribute predictor reads them, change as
+//! asked: `z' = argmin |z' - z|` subject to `P(z') - P(z) = alpha' - alpha` (the change, not the
+//! absolute value: the predictor's reading of a material's own latent is not its fitted
+//! attributes, and an unedited material must stay as it is). Every `z'` decodes to a table of
 //! the decoder, so the edit stays on its manifold; the material's latent moves no more than the
 //! request needs, so what the attributes do not describe moves least.
 //!
@@ -10,8 +12,8 @@
 //! (the latents `Phi(alpha_i)` of attribute vectors `alpha_i` drawn over the attribute ranges,
 //! seeded) in the regressor's feature space (the albedos and `ln(roughness)`), so it needs
 //! nothing beyond the representation and its regressor; with 7 attributes and `k >= 7` latent
-//! numbers the constraint is met by the minimum-norm step `z' = z + W^+ (f(alpha') - P(z))`
-//! (`W^+` the Moore-Penrose pseudo-inverse).
+//! numbers the constraint is met by the minimum-norm step `z' = z + W^+ (f(alpha') - f(alpha))`
+//! (`W^+` the Moore-Penrose pseudo-inverse, `f` the features).
 
 use crate::attributes::Attributes;
 use crate::error::{EvalError, Result};
@@ -75,8 +77,14 @@ impl AttributePredictor {
         &self.weights * z + &self.bias
     }
 
-    /// The latent closest to `latent` that the predictor reads as `requested`.
-    pub fn nearest(&self, latent: &[f32], requested: &Attributes) -> Result<Vec<f32>> {
+    /// The latent closest to `latent` (of a material whose attributes are `original`) whose
+    /// predicted attributes change by `requested - original`.
+    pub fn nearest(
+        &self,
+        latent: &[f32],
+        original: &Attributes,
+        requested: &Attributes,
+    ) -> Result<Vec<f32>> {
         if latent.len() != self.weights.ncols() {
             return Err(EvalError::Invalid(format!(
                 "a latent of {} numbers for a predictor of {}",
@@ -84,10 +92,13 @@ impl AttributePredictor {
                 self.weights.ncols()
             )));
         }
-        let target = features(&requested.to_array())
-            .map_err(|e| EvalError::Invalid(format!("the requested attributes: {e}")))?;
-        let gap = DVector::from_row_slice(&target) - self.predict(latent);
-        let step = &self.pseudo_inverse * gap;
+        let feature = |a: &Attributes| {
+            features(&a.to_array())
+                .map_err(|e| EvalError::Invalid(format!("the attributes of the edit: {e}")))
+        };
+        let (from, to) = (feature(original)?, feature(requested)?);
+        let change = DVector::from_iterator(7, (0..7).map(|i| to[i] - from[i]));
+        let step = &self.pseudo_inverse * change;
         Ok(latent.iter().zip(step.iter()).map(|(&z, &d)| z + d as f32).collect())
     }
 }
@@ -99,8 +110,9 @@ mod tests {
     use deepbrdf_model::DeviceKind;
     use std::path::Path;
 
-    /// On the shipped regressor: the nearest latent is read as the request, and its step from
-    /// the material's latent has no part the predictor cannot see (the minimum-norm step).
+    /// On the shipped regressor: the nearest latent's predicted attributes change as asked, an
+    /// identity edit does not move, and the step has no part the predictor cannot see (the
+    /// minimum-norm step).
     #[test]
     fn the_nearest_latent_is_read_as_the_request_with_the_smallest_step() {
         let device = DeviceKind::default_kind().expect("a backend").device().unwrap();
@@ -110,17 +122,20 @@ mod tests {
         let a = Attributes { diffuse: [0.3, 0.2, 0.1], specular: [0.05; 3], roughness: 0.1 };
         let z = regressor.predict(&a.to_array()).unwrap();
         let asked = Attributes { roughness: 0.2, diffuse: [0.15, 0.1, 0.05], ..a };
-        let nearest = p.nearest(&z, &asked).unwrap();
-        let read = p.predict(&nearest);
-        let want = features(&asked.to_array()).unwrap();
-        for (got, want) in read.iter().zip(want) {
-            assert!((got - want).abs() < 1e-4, "{read:?} vs {want:?}");
+        let nearest = p.nearest(&z, &a, &asked).unwrap();
+        let (before, after) = (p.predict(&z), p.predict(&nearest));
+        let (from, to) = (features(&a.to_array()).unwrap(), features(&asked.to_array()).unwrap());
+        for i in 0..7 {
+            let (got, want) = (after[i] - before[i], to[i] - from[i]);
+            assert!((got - want).abs() < 1e-4, "{i}: {got} vs {want}");
         }
+        // No change asked, no move.
+        assert_eq!(p.nearest(&z, &a, &a).unwrap(), z);
         // The step lies in the row space of W: projecting it there changes nothing.
         let step =
             DVector::from_iterator(z.len(), nearest.iter().zip(&z).map(|(a, b)| f64::from(a - b)));
         let projected = &p.pseudo_inverse * (&p.weights * &step);
         assert!((projected - &step).norm() < 1e-3 * step.norm().max(1e-9));
-        assert!(p.nearest(&z[1..], &asked).unwrap_err().to_string().contains("latent of"));
+        assert!(p.nearest(&z[1..], &a, &asked).unwrap_err().to_string().contains("latent of"));
     }
 }

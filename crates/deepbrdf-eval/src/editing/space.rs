@@ -24,8 +24,8 @@ pub enum EditMode {
     Paper,
     /// Keeps what the attributes do not explain: `Y' = Y + Phi(alpha') - Phi(alpha)`.
     Residual,
-    /// The latent nearest the material's that a linear latent-to-attribute predictor reads as
-    /// the request ([`crate::editing::nearest`]).
+    /// The latent nearest the material's whose attributes, as a linear latent-to-attribute
+    /// predictor reads them, change as asked ([`crate::editing::nearest`]).
     Nearest,
     /// The residual edit's change `D(Y) -> D(Y')` carried onto the table itself
     /// ([`Space::transfer`]): what the representation does not reconstruct is kept.
@@ -235,7 +235,7 @@ impl Space<'_> {
         mode: EditMode,
     ) -> Result<Vec<f32>> {
         if mode == EditMode::Nearest {
-            return AttributePredictor::of(self.regressor)?.nearest(latent, requested);
+            return AttributePredictor::of(self.regressor)?.nearest(latent, original, requested);
         }
         let target = self.latent_of(requested)?;
         Ok(match mode {

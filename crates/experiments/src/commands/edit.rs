@@ -29,8 +29,8 @@ pub struct Args {
     #[command(flatten)]
     pub edit: EditArgs,
     /// paper: Y' = Phi(alpha'); residual: Y' = Y + Phi(alpha') - Phi(alpha); nearest: the
-    /// latent nearest Y that a linear latent-to-attribute predictor reads as alpha'; transfer: the
-    /// residual edit's change carried onto the table itself; analytic: the table's fitted
+    /// latent nearest Y whose attributes, as a linear latent-to-attribute predictor reads them,
+    /// change by alpha' - alpha; transfer: the residual edit's change carried onto the table itself; analytic: the table's fitted
     /// Lambertian + GGX model swapped for the edited one, no network; stretch: the table's own
     /// highlight stretched to the new roughness and the albedos edited as analytic, no network;
     /// parts: the table split into a diffuse floor, up to two lobes, a retro-reflective ridge
