@@ -6,7 +6,7 @@
 
 use crate::attributes::Attributes;
 use crate::editing::nearest::AttributePredictor;
-use crate::editing::parts::{fit_parts, parts_edit, Parts, PartsConfig};
+use crate::editing::parts::{fit_and_edit, Parts};
 use crate::editing::{analytic_edit, carry_edit, stretch_edit, Edit};
 use crate::error::{EvalError, Result};
 use crate::harness::Codec;
@@ -89,10 +89,7 @@ impl EditMode {
         match self {
             Self::Analytic => analytic_edit(table, original, requested),
             Self::Stretch => stretch_edit(table, original, requested),
-            Self::Parts => {
-                let parts = fit_parts(table, &PartsConfig::default())?.parts;
-                parts_edit(table, &parts, original, requested)
-            }
+            Self::Parts => Ok(fit_and_edit(table, original, requested)?.0),
             Self::Paper | Self::Residual | Self::Transfer | Self::Nearest => {
                 Err(EvalError::Invalid(format!("the {self} edit needs a model and its regressor")))
             }
@@ -266,8 +263,7 @@ pub fn edit_material(
         (false, _) => {
             let requested = edit.apply(original)?;
             if mode == EditMode::Parts {
-                let parts = fit_parts(table, &PartsConfig::default())?.parts;
-                let table = parts_edit(table, &parts, original, &requested)?;
+                let (table, parts) = fit_and_edit(table, original, &requested)?;
                 return Ok(Edited { requested, table, parts: Some(parts) });
             }
             let table = mode.edit_without_network(table, original, &requested)?;

@@ -23,7 +23,7 @@
 //! A table that is exactly its parts becomes exactly the parts at the new roughness (up to the
 //! interpolation between theta_h bins); cells the table holds invalid stay invalid.
 
-use super::{CellAngles, Parts, FLOOR, LOBE, RETRO, SHEEN};
+use super::{fit_parts, CellAngles, Parts, PartsConfig, FLOOR, LOBE, MAX_LOBES, RETRO, SHEEN};
 use crate::attributes::{Attributes, MAX_ROUGHNESS, MIN_ROUGHNESS};
 use crate::editing::analytic_edit;
 use crate::editing::stretch::Source;
@@ -37,6 +37,17 @@ use std::f64::consts::PI;
 /// metal's: a dielectric's Fresnel reflectance at normal incidence is at most 0.11 of its
 /// grazing one for indices up to 2 (and 0.36 for 4), a conductor's 0.5-0.97.
 pub const METAL_SHARE: f64 = 0.25;
+
+/// `table`, whose fitted attributes are `fitted`, edited to `requested` by its parts, fitted
+/// first with the default settings: the edited table and the parts.
+pub fn fit_and_edit(
+    table: &MerlTable,
+    fitted: &Attributes,
+    requested: &Attributes,
+) -> Result<(MerlTable, Parts)> {
+    let parts = fit_parts(table, &PartsConfig::default())?.parts;
+    Ok((parts_edit(table, &parts, fitted, requested)?, parts))
+}
 
 /// `table`, whose parts are `parts` and fitted attributes `fitted`, edited to `requested`
 /// (module documentation).
@@ -110,8 +121,7 @@ pub fn parts_edit(
                 let (factor, add) = floor[c];
                 here.floor[c] * factor + add + here.other[c]
             });
-            let a = CellAngles::of(i, j, k).expect("a split cell is above the horizon");
-            let m = a.grazing();
+            let m = here.grazing;
             for (n, lobe) in parts.lobes.iter().enumerate() {
                 if body[n] {
                     continue; // with the floor
@@ -134,7 +144,10 @@ pub fn parts_edit(
                         Some(v.map(|x| x * f))
                     }),
                 };
-                let moved = moved.unwrap_or_else(|| lobe.value_at(lobe.alpha * s, &a));
+                let moved = moved.unwrap_or_else(|| {
+                    let a = CellAngles::of(i, j, k).expect("a split cell is above the horizon");
+                    lobe.value_at(lobe.alpha * s, &a)
+                });
                 for c in 0..3 {
                     let (kn, kg) = lobe_factors[n][c];
                     let (wn, wg) = (lobe.normal[c] * (1.0 - m), lobe.grazing[c] * m);
@@ -168,7 +181,10 @@ struct Split {
     floor: [f64; 3],
     /// The ridge's and the sheen's shares together: they stay where they are.
     other: [f64; 3],
-    lobes: Vec<[f64; 3]>,
+    /// Each lobe's share (the first `parts.lobes.len()`).
+    lobes: [[f64; 3]; MAX_LOBES],
+    /// The cell's Schlick weight `(1 - cos theta_d)^5`.
+    grazing: f64,
 }
 
 /// Every cell's split: None where a channel is invalid or the cell lies below the horizon. The
@@ -183,7 +199,8 @@ fn split(table: &MerlTable, parts: &Parts, body: &[bool]) -> Vec<Option<Split>> 
                 return None;
             }
             let (i, j, k) = cell_coords(cell);
-            let split = parts.split(t, &CellAngles::of(i, j, k)?);
+            let angles = CellAngles::of(i, j, k)?;
+            let split = parts.split(t, &angles);
             let part = |p: usize| split[p];
             let (retro, sheen) = (part(RETRO), part(SHEEN));
             // Where no part has a value, the whole cell stays as it is.
@@ -198,7 +215,8 @@ fn split(table: &MerlTable, parts: &Parts, body: &[bool]) -> Vec<Option<Split>> 
             Some(Split {
                 floor,
                 other: std::array::from_fn(|c| retro[c] + sheen[c] + unexplained[c]),
-                lobes: (0..parts.lobes.len()).map(|k| part(LOBE + k)).collect(),
+                lobes: std::array::from_fn(|k| part(LOBE + k)),
+                grazing: angles.grazing(),
             })
         })
         .collect()

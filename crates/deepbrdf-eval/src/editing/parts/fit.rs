@@ -17,13 +17,13 @@
 //! refined by golden-section search in log space, one at a time. Deterministic: no random
 //! numbers, fixed reduction orders.
 
-use super::{floor_shape, lobe_shape, retro_shape, sheen_shape, CellAngles};
+use super::design::{solve, Columns, Design, Samples, Shape};
 use super::{Distribution, PartFloor, PartLobe, PartRetro, PartSheen, Parts, MAX_LOBES};
 use crate::error::{EvalError, Result};
 use crate::golden::golden_section;
-use deepbrdf_data::merl::{cell_index, CELLS, N_PHI_D, N_THETA_D, N_THETA_H};
+use deepbrdf_data::merl::{N_PHI_D, N_THETA_D};
 use deepbrdf_data::MerlTable;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 use rayon::prelude::*;
 
 /// Settings of [`fit_parts`].
@@ -96,31 +96,6 @@ const SIGMA_MAX: f64 = deepbrdf_data::corpus::material::SIGMA_RANGE.1;
 /// Fewest valid sampled cells a fit accepts.
 const MIN_CELLS: usize = 200;
 
-/// One shape: a column of the design.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Shape {
-    /// A floor of sigma and coat index.
-    Floor(f64, Option<f64>),
-    /// A lobe's normal-incidence (`false`) or grazing (`true`) column at roughness alpha.
-    Lobe(Distribution, f64, bool),
-    Retro(f64),
-    Sheen(f64),
-}
-
-impl Shape {
-    fn eval(self, a: &CellAngles) -> f64 {
-        match self {
-            Shape::Floor(sigma, coat) => floor_shape(sigma, coat, a),
-            Shape::Lobe(distribution, alpha, grazing) => {
-                let m = a.grazing();
-                lobe_shape(distribution, alpha, a) * if grazing { m } else { 1.0 - m }
-            }
-            Shape::Retro(n) => retro_shape(n, a),
-            Shape::Sheen(r) => sheen_shape(r, a),
-        }
-    }
-}
-
 /// A floor's sigma and coat index.
 type Floor = (f64, Option<f64>);
 /// A lobe's distribution and roughness.
@@ -177,215 +152,10 @@ impl Structure {
     }
 }
 
-/// The sampled cells: their angles, weights and values.
-struct Samples {
-    angles: Vec<CellAngles>,
-    weight: Vec<f64>,
-    values: [Vec<f64>; 3],
-    /// `sum w v^2` per channel.
-    energy: [f64; 3],
-}
-
-impl Samples {
-    fn of(table: &MerlTable, config: &PartsConfig) -> Self {
-        let mut s = Samples {
-            angles: vec![],
-            weight: vec![],
-            values: Default::default(),
-            energy: [0.0; 3],
-        };
-        for i in 0..N_THETA_H {
-            for j in (0..N_THETA_D).step_by(config.theta_d_stride) {
-                for k in (0..N_PHI_D).step_by(config.phi_d_stride) {
-                    let cell = cell_index(i, j, k);
-                    let Some(a) = CellAngles::of(i, j, k) else { continue };
-                    if !table.is_valid(cell) {
-                        continue;
-                    }
-                    let v: [f64; 3] =
-                        std::array::from_fn(|c| f64::from(table.values()[c * CELLS + cell]));
-                    let w = a.cos_i * a.cos_o;
-                    let mean = (v[0] + v[1] + v[2]) / 3.0;
-                    let weight = (w / (config.offset + w * mean)).powi(2);
-                    s.angles.push(a);
-                    s.weight.push(weight);
-                    for c in 0..3 {
-                        s.values[c].push(v[c]);
-                        s.energy[c] += weight * v[c] * v[c];
-                    }
-                }
-            }
-        }
-        s
-    }
-
-    fn column(&self, shape: Shape) -> Vec<f64> {
-        self.angles.par_iter().map(|a| shape.eval(a)).collect()
-    }
-
-    /// `sum w x y`.
-    fn dot(&self, x: &[f64], y: &[f64]) -> f64 {
-        self.weight.iter().zip(x.iter().zip(y)).map(|(w, (a, b))| w * a * b).sum()
-    }
-}
-
-/// The normal equations of a set of columns: the Gram matrix and each channel's right side.
-struct Normal {
-    gram: DMatrix<f64>,
-    rhs: [DVector<f64>; 3],
-}
-
-/// The columns of every grid shape and their normal equations, computed once.
-struct Design {
-    shapes: Vec<Shape>,
-    gram: DMatrix<f64>,
-    rhs: [Vec<f64>; 3],
-}
-
-impl Design {
-    fn new(samples: &Samples, shapes: Vec<Shape>) -> Self {
-        let columns: Vec<Vec<f64>> = shapes.par_iter().map(|&s| samples.column(s)).collect();
-        let n = shapes.len();
-        let pairs: Vec<(usize, usize)> = (0..n).flat_map(|i| (i..n).map(move |j| (i, j))).collect();
-        let dots: Vec<f64> =
-            pairs.par_iter().map(|&(i, j)| samples.dot(&columns[i], &columns[j])).collect();
-        let mut gram = DMatrix::zeros(n, n);
-        for (&(i, j), &d) in pairs.iter().zip(&dots) {
-            gram[(i, j)] = d;
-            gram[(j, i)] = d;
-        }
-        let rhs = std::array::from_fn(|c| {
-            columns.par_iter().map(|col| samples.dot(col, &samples.values[c])).collect()
-        });
-        Self { shapes, gram, rhs }
-    }
-
-    fn index(&self, shape: Shape) -> usize {
-        self.shapes.iter().position(|&s| s == shape).expect("a grid shape")
-    }
-
-    fn normal(&self, structure: &Structure) -> Normal {
-        let idx: Vec<usize> = structure.shapes().into_iter().map(|s| self.index(s)).collect();
-        let m = idx.len();
-        let gram = DMatrix::from_fn(m, m, |a, b| self.gram[(idx[a], idx[b])]);
-        let rhs = std::array::from_fn(|c| DVector::from_fn(m, |a, _| self.rhs[c][idx[a]]));
-        Normal { gram, rhs }
-    }
-}
-
-/// Columns computed off the grid during the refinement, each shape once.
-struct Columns<'a> {
-    samples: &'a Samples,
-    computed: Vec<(Shape, Vec<f64>)>,
-}
-
-impl<'a> Columns<'a> {
-    fn new(samples: &'a Samples) -> Self {
-        Self { samples, computed: Vec::new() }
-    }
-
-    /// The normal equations of `structure`.
-    fn normal(&mut self, structure: &Structure) -> Normal {
-        let shapes = structure.shapes();
-        for &shape in &shapes {
-            if !self.computed.iter().any(|(s, _)| *s == shape) {
-                self.computed.push((shape, self.samples.column(shape)));
-            }
-        }
-        let columns: Vec<&Vec<f64>> = shapes
-            .iter()
-            .map(|shape| &self.computed.iter().find(|(s, _)| s == shape).expect("computed").1)
-            .collect();
-        let m = columns.len();
-        let samples = self.samples;
-        let pairs: Vec<(usize, usize)> = (0..m).flat_map(|i| (i..m).map(move |j| (i, j))).collect();
-        let dots: Vec<f64> =
-            pairs.par_iter().map(|&(i, j)| samples.dot(columns[i], columns[j])).collect();
-        let mut gram = DMatrix::zeros(m, m);
-        for (&(i, j), &d) in pairs.iter().zip(&dots) {
-            gram[(i, j)] = d;
-            gram[(j, i)] = d;
-        }
-        let rhs = std::array::from_fn(|c| {
-            DVector::from_fn(m, |a, _| samples.dot(columns[a], &samples.values[c]))
-        });
-        Normal { gram, rhs }
-    }
-}
-
-/// Each channel's non-negative colours and the relative error of the solution.
-fn solve(normal: &Normal, energy: &[f64; 3]) -> ([DVector<f64>; 3], f64) {
-    let x: [DVector<f64>; 3] = std::array::from_fn(|c| nnls(&normal.gram, &normal.rhs[c]));
-    let residual: f64 = (0..3)
-        .map(|c| {
-            let x = &x[c];
-            energy[c] - 2.0 * x.dot(&normal.rhs[c]) + x.dot(&(&normal.gram * x))
-        })
-        .sum();
-    let total: f64 = energy.iter().sum();
-    (x, (residual / total.max(f64::MIN_POSITIVE)).max(0.0))
-}
-
-/// Lawson and Hanson's active-set solution of `min x' G x - 2 r' x` over `x >= 0`, `G` the
-/// (positive semi-definite) Gram matrix of the columns.
-fn nnls(gram: &DMatrix<f64>, rhs: &DVector<f64>) -> DVector<f64> {
-    let m = rhs.len();
-    let scale = (0..m).map(|i| gram[(i, i)]).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
-    let tol = 1e-12 * scale;
-    let mut x = DVector::zeros(m);
-    let mut passive = vec![false; m];
-    for _ in 0..3 * m {
-        let w = rhs - gram * &x;
-        let next =
-            (0..m).filter(|&j| !passive[j] && w[j] > tol).max_by(|&a, &b| w[a].total_cmp(&w[b]));
-        let Some(j) = next else { break };
-        passive[j] = true;
-        for _ in 0..3 * m {
-            let p: Vec<usize> = (0..m).filter(|&i| passive[i]).collect();
-            let z = solve_passive(gram, rhs, &p);
-            if p.iter().zip(z.iter()).all(|(_, &v)| v > 0.0) {
-                p.iter().zip(z.iter()).for_each(|(&i, &v)| x[i] = v);
-                break;
-            }
-            // Step from x towards z until the first passive value reaches 0; drop it.
-            let step = p
-                .iter()
-                .zip(z.iter())
-                .filter(|(_, &v)| v <= 0.0)
-                .map(|(&i, &v)| x[i] / (x[i] - v))
-                .fold(1.0, f64::min);
-            for (&i, &v) in p.iter().zip(z.iter()) {
-                x[i] += step * (v - x[i]);
-                if x[i] <= 1e-15 * scale.sqrt() {
-                    x[i] = 0.0;
-                    passive[i] = false;
-                }
-            }
-            if !passive.iter().any(|&b| b) {
-                break;
-            }
-        }
-    }
-    x
-}
-
-/// The unconstrained solution over the passive columns `p` (a small ridge keeps a nearly
-/// dependent pair solvable).
-fn solve_passive(gram: &DMatrix<f64>, rhs: &DVector<f64>, p: &[usize]) -> Vec<f64> {
-    let n = p.len();
-    let ridge = 1e-10 * p.iter().map(|&i| gram[(i, i)]).sum::<f64>() / n as f64;
-    let g = DMatrix::from_fn(n, n, |a, b| gram[(p[a], p[b])] + if a == b { ridge } else { 0.0 });
-    let r = DVector::from_fn(n, |a, _| rhs[p[a]]);
-    match g.clone().cholesky() {
-        Some(ch) => ch.solve(&r).iter().copied().collect(),
-        None => g.lu().solve(&r).map_or(vec![0.0; n], |v| v.iter().copied().collect()),
-    }
-}
-
 /// Fits `table`'s [`Parts`] (module documentation).
 pub fn fit_parts(table: &MerlTable, config: &PartsConfig) -> Result<PartsFit> {
     validate(config)?;
-    let samples = Samples::of(table, config);
+    let samples = Samples::of(table, config.theta_d_stride, config.phi_d_stride, config.offset);
     let cells = samples.angles.len();
     if cells < MIN_CELLS || samples.energy.iter().sum::<f64>() <= 0.0 {
         return Err(EvalError::Invalid(format!(
@@ -411,7 +181,7 @@ pub fn fit_parts(table: &MerlTable, config: &PartsConfig) -> Result<PartsFit> {
     shapes.extend(config.sheen_roughness.iter().map(|&r| Shape::Sheen(r)));
     let design = Design::new(&samples, shapes);
     let score = |s: &Structure| {
-        let (_, err) = solve(&design.normal(s), &samples.energy);
+        let (_, err) = solve(&design.normal(&s.shapes()), &samples.energy);
         (err + config.error_floor) * (1.0 + config.penalty).powi(s.parts() as i32)
     };
     // Stage 1: the lobe sets under each floor alone.
@@ -500,7 +270,7 @@ fn refine(
         false => 0.0,
     };
     let mut columns = Columns::new(samples);
-    let mut error_of = |s: &Structure| solve(&columns.normal(s), &samples.energy).1;
+    let mut error_of = |s: &Structure| solve(&columns.normal(&s.shapes()), &samples.energy).1;
     for _ in 0..config.refine_passes {
         for n in 0..structure.params().len() {
             let p = structure.params()[n];
@@ -536,7 +306,7 @@ fn refine(
             }
         }
     }
-    let (colours, err) = solve(&Columns::new(samples).normal(&structure), &samples.energy);
+    let (colours, err) = solve(&Columns::new(samples).normal(&structure.shapes()), &samples.energy);
     (structure, colours, err)
 }
 

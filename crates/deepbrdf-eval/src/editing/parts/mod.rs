@@ -23,10 +23,11 @@
 //! - sheen: `D_charlie(r) / (4 (cos_i + cos_o - cos_i cos_o))` (Estevez and Kulla 2017 with
 //!   Neubelt and Pettineo's visibility, the corpus' sheen).
 
+mod design;
 pub mod edit;
 pub mod fit;
 
-pub use edit::parts_edit;
+pub use edit::{fit_and_edit, parts_edit};
 pub use fit::{fit_parts, PartsConfig, PartsFit};
 
 use deepbrdf_data::corpus::diffuse::Diffuse;
