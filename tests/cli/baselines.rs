@@ -257,3 +257,61 @@ fn baselines_runs_sun2018_beside_ipca() {
     let err = util::stderr(&out);
     assert!(err.contains("k = 1") && err.contains("no specular"), "{err}");
 }
+
+#[test]
+fn baselines_train_the_deepbrdf_method_from_a_configuration_file() {
+    // A narrow Table 1 (mean offset, standardised, warm-up) from a file, k set per --k; a
+    // second run loads the finished models instead of training again.
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("data");
+    write_materials(&data, 3);
+    let config = serde_json::json!({
+        "batch_size": 2, "checkpoint_seconds": 60.0, "epochs": 2, "final_lr_factor": 0.5,
+        "learning_rate": 1e-3, "warmup_epochs": 1.0, "seed": 0, "threads": 1,
+        "slice_dropout": null,
+        "model": {"latent": 7, "negative_slope": 0.01, "architecture": {"convolutional": {
+            "projection": 2, "encoder_channels": [2, 2, 2], "residual_blocks": 1,
+            "decoder_channels": [2, 2], "mean_offset": true, "he_init": true,
+            "standardise": true, "conv": "gemm"}}},
+        "optimizer": {"amsgrad": false, "beta_1": 0.9, "beta_2": 0.999, "epsilon": 1e-8,
+            "grad_clipping": null, "weight_decay": null}
+    });
+    std::fs::write(dir.path().join("c.json"), config.to_string()).unwrap();
+    let data = data.to_str().unwrap();
+    let args = [
+        "baselines",
+        "--data",
+        data,
+        "--k",
+        "1,2",
+        "--methods",
+        "pca,deepbrdf",
+        "--config",
+        "c.json",
+        "--measures",
+        "mapped_mse",
+        "--out",
+        "res",
+    ];
+    let out = util::run_in(dir.path(), &args);
+    assert!(out.status.success(), "{}", util::stderr(&out));
+    let rows = read_results(&dir.path().join("res/results.csv"));
+    for k in [1, 2] {
+        let key = ("DeepBRDF".to_string(), k, "material-0".to_string(), "mapped_mse".to_string());
+        assert!(rows.get(&key).is_some_and(|v| v.is_finite()), "{k}: {rows:?}");
+        let saved = dir.path().join(format!("res/models/fold0/k{k}/train_config.json"));
+        let saved: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(saved).unwrap()).unwrap();
+        assert_eq!(saved["model"]["latent"], k);
+        assert_eq!(saved["warmup_epochs"], 1.0);
+    }
+    let again = util::run_in(dir.path(), &[&args[..], &["--force"]].concat());
+    assert!(again.status.success(), "{}", util::stderr(&again));
+    util::assert_clean_failure(
+        &util::run_in(
+            dir.path(),
+            &["baselines", "--data", data, "--config", "missing.json", "--methods", "deepbrdf"],
+        ),
+        "missing.json",
+    );
+}

@@ -241,6 +241,29 @@ impl TrainingSet {
             .collect()
     }
 
+    /// The per-value spread of the set (standard deviation over the BRDFs valid there, in
+    /// layout order), floored at a tenth of its root mean square over the valid values so
+    /// that no value is divided by almost nothing; 1 where no BRDF is valid.
+    pub fn spread(&self) -> Vec<f32> {
+        let mean = self.mean();
+        let mut sum = vec![0f64; LAYOUT_VALUES];
+        let mut count = vec![0u32; LAYOUT_VALUES];
+        for (input, mask) in self.inputs.iter().zip(&self.masks) {
+            for (i, (&x, &m)) in input.iter().zip(mask.iter()).enumerate() {
+                if m != 0.0 {
+                    sum[i] += (f64::from(x) - f64::from(mean[i])).powi(2);
+                    count[i] += 1;
+                }
+            }
+        }
+        let variance: Vec<Option<f64>> =
+            sum.iter().zip(&count).map(|(&s, &c)| (c > 0).then(|| s / f64::from(c))).collect();
+        let valid = variance.iter().flatten().count().max(1);
+        let floor = 0.1 * (variance.iter().flatten().sum::<f64>() / valid as f64).sqrt();
+        let floor = if floor > 0.0 { floor } else { 1.0 };
+        variance.iter().map(|v| v.map_or(1.0, |v| v.sqrt().max(floor)) as f32).collect()
+    }
+
     /// A short digest of the set (label, names and a strided sample of values and masks), so
     /// a resumed run can check it sees the same data.
     pub fn fingerprint(&self) -> String {
@@ -285,6 +308,29 @@ mod tests {
         let mean = set.mean();
         assert_eq!(mean[0], 2.0); // only "b" is valid at value 0
         assert_eq!(mean[1], 3.0); // (1 + 2 + 6) / 3
+    }
+
+    #[test]
+    fn the_spread_is_the_deviation_over_valid_brdfs_floored() {
+        // Value 0: only "b" valid (spread 0, floored at a tenth of the RMS spread); value 2:
+        // no BRDF valid (1); every other value: 1, 3, 5 (spread sqrt(8/3)).
+        let mut mask_ac = layout(1.0);
+        mask_ac[0] = 0.0;
+        mask_ac[2] = 0.0;
+        let mut mask_b = layout(1.0);
+        mask_b[2] = 0.0;
+        let set = TrainingSet::from_layouts(
+            "test",
+            vec!["a".into(), "b".into(), "c".into()],
+            vec![layout(1.0), layout(3.0), layout(5.0)],
+            vec![mask_ac.clone(), mask_b, mask_ac],
+        )
+        .unwrap();
+        let spread = set.spread();
+        let full = (8.0f64 / 3.0).sqrt();
+        assert!((f64::from(spread[1]) - full).abs() < 1e-6, "{}", spread[1]);
+        assert_eq!(spread[2], 1.0);
+        assert!((f64::from(spread[0]) - 0.1 * full).abs() < 1e-5, "{}", spread[0]);
     }
 
     #[test]

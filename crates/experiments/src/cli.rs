@@ -106,6 +106,9 @@ pub enum Command {
     /// Fig. 4: the same network trained with the L2 and the L1 loss (`train --loss l1`), each
     /// material as measured and as each model reconstructs it, with the image RelAE of each.
     FiguresLoss(commands::figures_loss::Args),
+    /// Table 1's training schedules compared: the loss curves of runs against epochs and
+    /// training time (`scripts/table1-schedules.sh`), with a summary table.
+    FiguresSchedules(commands::figures_schedules::Args),
     /// Figs. 5 and 6: the materials' latents in their principal plane, and a few materials
     /// reconstructed by DeepBRDF, PCA and IPCA at several k, with the image RelAE of each.
     FiguresQuality(commands::figures_quality::Args),
@@ -161,6 +164,7 @@ impl Cli {
             Command::EditKnown(args) => commands::edit_known::run(args, &progress),
             Command::FiguresGeneralize(args) => commands::figures_generalize::run(args, &progress),
             Command::FiguresLoss(args) => commands::figures_loss::run(args, &progress),
+            Command::FiguresSchedules(args) => commands::figures_schedules::run(args, &progress),
             Command::FiguresQuality(args) => commands::figures_quality::run(args, &progress),
             Command::RenderSet(args) => commands::render_set::run(args, &progress),
             Command::TrainRecovery(args) => commands::train_recovery::run(args, &progress),

@@ -8,13 +8,14 @@ pub mod latent_plane;
 mod plots;
 pub mod reconstruction_sheet;
 pub mod scatter;
+pub mod schedules;
 pub mod slices;
 pub mod strip;
 
 pub use compact::compact_svg;
 pub use latent_map::{LatentMap, LatentMapInput};
 pub use latent_plane::LatentPlane;
-pub use plots::{write_chart, write_panels, LineChart, Series};
+pub use plots::{write_chart, write_panels, write_panels_png, LineChart, Series};
 pub use reconstruction_sheet::{ReconstructionSheet, SheetInput};
 pub use scatter::{draw_scatter, ScatterPlot, ScatterPoint};
 pub use strip::{figure_caption, strip};

@@ -65,6 +65,38 @@ pub fn write_panels(charts: &[LineChart], stem: &Path) -> Result<()> {
     Ok(write_atomic(&svg_path, super::compact::compact_svg(&svg).as_bytes())?)
 }
 
+/// Writes `charts` stacked top to bottom in one figure to `<stem>.png` (through a temp file
+/// and a rename): for a figure looked at in a browser or an issue rather than printed.
+pub fn write_panels_png(charts: &[LineChart], stem: &Path) -> Result<()> {
+    deepbrdf_render::sheet::register_font()?;
+    let png_path = with_ext(stem, "png");
+    if charts.is_empty() {
+        return Err(EvalError::Invalid(format!("{}: no chart to draw", png_path.display())));
+    }
+    let w = charts.iter().map(|c| c.size.0).max().unwrap_or(1);
+    let h: u32 = charts.iter().map(|c| c.size.1).sum();
+    if u64::from(w) * u64::from(h) > 64_000_000 {
+        return Err(EvalError::Invalid(format!(
+            "{}: figure of {w} x {h} pixels",
+            png_path.display()
+        )));
+    }
+    let mut pixels = vec![0u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut pixels, (w, h)).into_drawing_area();
+        draw_stacked(&root, charts)
+            .map_err(|e| EvalError::Invalid(format!("{}: {e}", png_path.display())))?;
+        root.present().map_err(|e| EvalError::Invalid(format!("{}: {e}", png_path.display())))?;
+    }
+    let image = image::RgbImage::from_raw(w, h, pixels)
+        .ok_or_else(|| EvalError::Invalid(format!("{}: pixel buffer size", png_path.display())))?;
+    let mut bytes = Vec::new();
+    image
+        .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+        .map_err(|e| EvalError::Invalid(format!("{}: {e}", png_path.display())))?;
+    Ok(write_atomic(&png_path, &bytes)?)
+}
+
 /// Draws each chart in its own horizontal band of `root`, top to bottom.
 fn draw_stacked<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
@@ -149,7 +181,7 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &LineChart) ->
         x0 -= 0.5;
         x1 += 0.5;
     } else {
-        let pad = ((x1 - x0) * 0.04).max(0.5);
+        let pad = if x1 > x0 { (x1 - x0) * 0.04 } else { 0.5 };
         x0 -= pad;
         x1 += pad;
     }
@@ -179,7 +211,17 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &LineChart) ->
                 String::new()
             }
         }
-        None => format!("{x}"),
+        // At most three decimals, trailing zeros dropped: ticks such as 0.1 + 0.2 read 0.3.
+        None => {
+            let s = format!("{x:.3}");
+            let s =
+                if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.') } else { &s };
+            if s == "-0" {
+                "0".to_string()
+            } else {
+                s.to_string()
+            }
+        }
     };
     let x_labels = chart.categories.as_ref().map(|c| c.len()).unwrap_or(12);
     let x_style = if chart.rotate_categories {

@@ -115,6 +115,15 @@ impl AutoencoderConfig {
         }
     }
 
+    /// Whether the network standardises per value around its offset
+    /// ([`ConvolutionalConfig::standardise`]); never a slice network.
+    pub fn standardise(&self) -> bool {
+        match &self.architecture {
+            Architecture::Convolutional(c) => c.standardise == Some(true),
+            Architecture::Slice(_) => false,
+        }
+    }
+
     /// Checks the sizes once, so [`init`](Self::init) cannot build a degenerate network.
     pub fn validate(&self) -> crate::error::Result<()> {
         if self.latent == 0 || self.latent > MAX_WIDTH {

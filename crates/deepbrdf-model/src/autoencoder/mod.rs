@@ -124,6 +124,38 @@ impl Autoencoder {
         }
     }
 
+    /// Sets the fixed per-value scale (the training spread, 540 x 90 x 90 in layout order,
+    /// every value positive). Errors if the configuration does not standardise or `values` has
+    /// the wrong length.
+    pub fn with_scale(self, values: &[f32]) -> crate::error::Result<Self> {
+        if values.len() != INPUT_VALUES {
+            return Err(ModelError::Invalid(format!(
+                "a scale has {INPUT_VALUES} values, got {}",
+                values.len()
+            )));
+        }
+        if let Some(i) = values.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
+            return Err(ModelError::Invalid(format!("scale value {i} is not positive and finite")));
+        }
+        let data = TensorData::new(values.to_vec(), [INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE]);
+        match self {
+            Self::Convolutional(mut c) => {
+                let Some(old) = c.scale.take() else {
+                    return Err(ModelError::Invalid(
+                        "this configuration does not standardise per value".into(),
+                    ));
+                };
+                c.scale = Some(
+                    old.map(|old| Tensor::from_data(data, &old.device())).set_require_grad(false),
+                );
+                Ok(Self::Convolutional(c))
+            }
+            Self::Slice(_) => {
+                Err(ModelError::Invalid("the slice network has no per-value scale".into()))
+            }
+        }
+    }
+
     /// The slice network, if the network is one.
     pub fn slice(&self) -> Option<&SliceNetwork> {
         match self {

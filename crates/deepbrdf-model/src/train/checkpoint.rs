@@ -88,6 +88,12 @@ pub(crate) fn saved_run_config(path: &Path) -> Result<serde_json::Value> {
     Ok(saved_state(path)?.config)
 }
 
+/// The per-epoch log of the run whose checkpoint is at `path`, with the seconds each epoch
+/// took (the CSV log leaves them out: they are not determined by the seed).
+pub fn saved_log(path: &Path) -> Result<Vec<EpochRecord>> {
+    Ok(saved_state(path)?.log)
+}
+
 fn state_of(c: &Container, path: &Path) -> Result<TrainState> {
     let state = c.get("state").ok_or_else(|| missing(path, "training state"))?;
     serde_json::from_slice(state)

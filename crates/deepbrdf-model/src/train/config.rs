@@ -19,6 +19,10 @@ pub struct LoopConfig {
     /// last step; 1.0 keeps it constant ([`super::schedule`]).
     #[config(default = 1.0)]
     pub final_lr_factor: f64,
+    /// The learning rate rises linearly from `learning_rate / warm-up steps` over the first
+    /// this many epochs (0: no warm-up; [`super::schedule`]).
+    #[config(default = 0.0)]
+    pub warmup_epochs: f64,
     /// Passes over the training examples.
     #[config(default = 100)]
     pub epochs: usize,
@@ -50,6 +54,12 @@ impl LoopConfig {
             return Err(ModelError::Invalid(format!(
                 "learning rate {} with final factor {} (need lr > 0 and 0 < factor <= 1)",
                 self.learning_rate, self.final_lr_factor
+            )));
+        }
+        if !(self.warmup_epochs >= 0.0 && self.warmup_epochs <= self.epochs as f64) {
+            return Err(ModelError::Invalid(format!(
+                "a warm-up of {} epochs (need 0 to the {} epochs of the run)",
+                self.warmup_epochs, self.epochs
             )));
         }
         if self.epochs == 0 || self.batch_size == 0 || self.batch_size > 4096 {

@@ -19,7 +19,7 @@ mod progress;
 pub mod run;
 pub mod schedule;
 
-pub use checkpoint::{checkpoint_path, json_close, CHECKPOINT_FILE, CONFIG_FILE};
+pub use checkpoint::{checkpoint_path, json_close, saved_log, CHECKPOINT_FILE, CONFIG_FILE};
 pub use config::{adam, LoopConfig};
 pub use log::{EpochRecord, LOG_FILE};
 pub use order::epoch_order;

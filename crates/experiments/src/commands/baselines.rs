@@ -69,6 +69,10 @@ pub struct Args {
     /// The preset of the deepbrdf method.
     #[arg(long, default_value = "slice")]
     pub preset: deepbrdf_model::Preset,
+    /// A training configuration of the deepbrdf method (JSON, as `train` saves it, e.g.
+    /// `configs/table1-cpu.json`) instead of --preset; its k is set to each --k.
+    #[arg(long, value_name = "FILE", conflicts_with = "preset")]
+    pub config: Option<PathBuf>,
     #[command(flatten)]
     pub refine: crate::args::refine::RefineArg,
     /// The deepbrdf method stops each training at the end of the first epoch past this many
@@ -211,20 +215,24 @@ fn linear_methods(args: &Args) -> anyhow::Result<(BaselineMethod, BaselineMethod
     Ok((pca.keeping_last_fit(), ipca.keeping_last_fit()))
 }
 
-/// DeepBRDF trained with the preset for each k (its models under `--models`, else
-/// `out/models`), encoding with the refinement asked.
+/// DeepBRDF trained with the preset (or the configuration file) for each k (its models under
+/// `--models`, else `out/models`), encoding with the refinement asked.
 fn deep_method(args: &Args, out: &Path, data_label: &str) -> anyhow::Result<DeepMethod> {
     let preset = args.preset;
+    let file = args.config.as_deref().map(deepbrdf_model::TrainConfig::from_file).transpose()?;
+    let config_for = move |k| match &file {
+        Some(config) => {
+            let mut config = config.clone();
+            config.model.latent = k;
+            config
+        }
+        None => preset.train_config(k),
+    };
     let models = args.models.clone().unwrap_or_else(|| out.join("models"));
-    Ok(DeepMethod::new(
-        Box::new(move |k| preset.train_config(k)),
-        &models,
-        data_label,
-        crate::args::device::device()?,
-    )
-    .retaining(&[])
-    .refining(args.refine.refinement()?)
-    .training_within(args.time_limit))
+    Ok(DeepMethod::new(Box::new(config_for), &models, data_label, crate::args::device::device()?)
+        .retaining(&[])
+        .refining(args.refine.refinement()?)
+        .training_within(args.time_limit))
 }
 
 /// Refuses option combinations that cannot run, before any work.

@@ -20,6 +20,7 @@ pub mod figures_generalize;
 pub mod figures_loss;
 pub mod figures_quality;
 pub mod figures_recovery;
+pub mod figures_schedules;
 pub mod folds;
 pub mod highlights;
 pub mod info;

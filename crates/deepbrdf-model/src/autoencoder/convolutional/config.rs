@@ -26,6 +26,13 @@ pub struct ConvolutionalConfig {
     /// set with [`crate::Autoencoder::with_offset`]); the input is centred on it too. Not in Table 1.
     #[config(default = false)]
     pub mean_offset: bool,
+    /// Standardise per value: with the mean offset, the encoder sees each centred value divided
+    /// by its spread over the training set, and the decoder's output is multiplied by it (a
+    /// fixed per-value scale, set with [`crate::Autoencoder::with_scale`]), so every value is
+    /// learnt on one scale. Not in Table 1; none when absent (as in a configuration written
+    /// before the field existed).
+    #[config(default = "None")]
+    pub standardise: Option<bool>,
     /// He initialisation (normal, gain sqrt(2) for the leaky ReLUs, the residual blocks'
     /// second convolutions at zero so they start as identities) instead of PyTorch's default
     /// (uniform, gain 1/sqrt(3)), under which activations shrink layer after layer and the
@@ -73,6 +80,11 @@ impl ConvolutionalConfig {
             return Err(ModelError::Invalid(format!(
                 "a layer width of {w} is out of range (1 to {MAX_WIDTH})"
             )));
+        }
+        if self.standardise == Some(true) && !self.mean_offset {
+            return Err(ModelError::Invalid(
+                "standardising per value needs the mean offset (mean_offset: true)".into(),
+            ));
         }
         if self.residual_blocks > 64 {
             return Err(ModelError::Invalid(format!(

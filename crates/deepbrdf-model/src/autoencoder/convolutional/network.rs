@@ -3,7 +3,7 @@
 //! blocks at 64 x 12 x 12, FC to k, FC back and three deconvolutions to 128 x 24 x 24,
 //! 256 x 48 x 48 and 540 x 90 x 90 (the last 4x4), with PyTorch's padding conventions (spelled
 //! out at each layer); optionally narrower, behind a per-pixel projection of the 540 channels,
-//! and around a fixed offset.
+//! and around a fixed offset and scale.
 
 use burn::module::Param;
 use burn::nn::conv::{Conv2d, Conv2dConfig, ConvTranspose2d, ConvTranspose2dConfig};
@@ -26,25 +26,34 @@ fn zero_offset(device: &Device) -> Param<Tensor<3>> {
         .set_require_grad(false)
 }
 
+/// A unit scale (set with [`crate::Autoencoder::with_scale`]), not trained.
+fn unit_scale(device: &Device) -> Param<Tensor<3>> {
+    Param::from_tensor(Tensor::ones([INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE], device))
+        .set_require_grad(false)
+}
+
 /// The convolutional encoder and decoder.
 #[derive(Module, Debug)]
 pub struct Convolutional {
     project_in: Option<Projection>,
-    down: Vec<Conv2d>,
-    residual: Vec<ResidualBlock>,
-    to_latent: Linear,
-    from_latent: Linear,
-    up: Vec<ConvTranspose2d>,
+    pub(super) down: Vec<Conv2d>,
+    pub(super) residual: Vec<ResidualBlock>,
+    pub(super) to_latent: Linear,
+    pub(super) from_latent: Linear,
+    pub(super) up: Vec<ConvTranspose2d>,
     project_out: Option<Projection>,
     /// Fixed per-value offset (the training mean in mapped space), not trained.
     pub(crate) offset: Option<Param<Tensor<3>>>,
+    /// Fixed per-value scale (the training spread in mapped space), not trained: inputs are
+    /// divided by it and outputs multiplied.
+    pub(crate) scale: Option<Param<Tensor<3>>>,
     bottleneck_channels: usize,
     pub(crate) latent: usize,
     negative_slope: f64,
     /// How the convolutions are computed (not a parameter: set by the configuration, or
     /// [`Convolutional::with_conv`]).
     #[module(skip)]
-    conv: ConvAlgorithm,
+    pub(super) conv: ConvAlgorithm,
 }
 
 impl Convolutional {
@@ -111,6 +120,7 @@ impl Convolutional {
                 .projection
                 .map(|c| Projection::new(c, INPUT_CHANNELS, &linear, he, device)),
             offset: layers.mean_offset.then(|| zero_offset(device)),
+            scale: (layers.standardise == Some(true)).then(|| unit_scale(device)),
             bottleneck_channels: e2,
             latent,
             negative_slope,
@@ -130,6 +140,10 @@ impl Convolutional {
     pub(crate) fn encode_centred(&self, centred: Tensor<4>) -> Tensor<2> {
         let slope = self.negative_slope;
         let batch = centred.dims()[0];
+        let centred = match &self.scale {
+            Some(scale) => centred / scale.val().unsqueeze_dim::<4>(0), // [batch, 540, 90, 90]
+            None => centred,
+        };
         let mut x = match &self.project_in {
             Some(projection) => leaky_relu(projection.forward(centred), slope), // [batch, C, 90, 90]
             None => centred, // [batch, 540, 90, 90]
@@ -165,15 +179,18 @@ impl Convolutional {
             None => y,
         };
         debug_assert_eq!(y.dims()[1..], [INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE]);
-        y
+        match &self.scale {
+            Some(scale) => y * scale.val().unsqueeze_dim::<4>(0), // [batch, 540, 90, 90]
+            None => y,
+        }
     }
 }
 
 /// A residual block of §3.2 ([HZRS16]): two 3x3 convolutions, a leaky ReLU and a skip.
 #[derive(Module, Debug)]
 pub struct ResidualBlock {
-    conv1: Conv2d,
-    conv2: Conv2d,
+    pub(super) conv1: Conv2d,
+    pub(super) conv2: Conv2d,
 }
 
 impl ResidualBlock {

@@ -1,5 +1,6 @@
 //! The convolutional network's training step ([`TrainStep`]): its initialisation (seeded,
-//! around the training mean when it has an offset) and the eq. (4) loss and gradients of a
+//! around the training mean when it has an offset, scaled by the training spread when it
+//! standardises) and the eq. (4) loss and gradients of a
 //! batch on the full layouts, computed in parallel shards.
 
 use burn::optim::{GradientsParams, MultiGradientsParams};
@@ -42,8 +43,12 @@ impl TrainStep for ConvolutionalStep<'_> {
 
     fn init(&mut self, device: &Device) -> crate::error::Result<Autoencoder> {
         let model = self.skeleton(device)?;
-        match self.config.model.mean_offset() {
-            true => model.with_offset(&self.data.mean()),
+        let model = match self.config.model.mean_offset() {
+            true => model.with_offset(&self.data.mean())?,
+            false => model,
+        };
+        match self.config.model.standardise() {
+            true => model.with_scale(&self.data.spread()),
             false => Ok(model),
         }
     }

@@ -39,6 +39,10 @@ pub struct TrainConfig {
     /// last step; 1.0 keeps it constant (the paper's setting).
     #[config(default = 1.0)]
     pub final_lr_factor: f64,
+    /// Epochs over which the learning rate rises linearly to its schedule's (none in the
+    /// paper; none when absent, as in a configuration written before the field existed).
+    #[config(default = "None")]
+    pub warmup_epochs: Option<f64>,
     /// Passes over the training set (§3.2: 1000).
     #[config(default = 1000)]
     pub epochs: usize,
@@ -144,11 +148,42 @@ impl TrainConfig {
         self.loss_norm.unwrap_or_default()
     }
 
+    /// The schedule in a few words: initialisation, offset and scale, optimiser's rate,
+    /// warm-up and decay, batch size, slice dropout.
+    pub fn schedule_summary(&self) -> String {
+        let mut parts = Vec::new();
+        if let crate::autoencoder::Architecture::Convolutional(c) = &self.model.architecture {
+            parts.push(if c.he_init { "He init" } else { "PyTorch init" }.to_string());
+            if c.standardise == Some(true) {
+                parts.push("standardised per value".into());
+            } else if c.mean_offset {
+                parts.push("mean offset".into());
+            }
+        }
+        let mut rate = format!("Adam {:.0e}", self.learning_rate);
+        if let Some(w) = self.warmup_epochs.filter(|&w| w > 0.0) {
+            rate.push_str(&format!(", warm-up {w} epochs"));
+        }
+        if self.final_lr_factor < 1.0 {
+            rate.push_str(&format!(
+                ", cosine to x{} over {} epochs",
+                self.final_lr_factor, self.epochs
+            ));
+        }
+        parts.push(rate);
+        parts.push(format!("batch {}", self.batch_size));
+        if self.slice_dropout.is_some() {
+            parts.push("slice dropout".into());
+        }
+        parts.join(", ")
+    }
+
     /// The loop's settings of this configuration.
     pub fn loop_config(&self) -> LoopConfig {
         LoopConfig::new(self.optimizer.clone())
             .with_learning_rate(self.learning_rate)
             .with_final_lr_factor(self.final_lr_factor)
+            .with_warmup_epochs(self.warmup_epochs.unwrap_or(0.0))
             .with_epochs(self.epochs)
             .with_batch_size(self.batch_size)
             .with_seed(self.seed)

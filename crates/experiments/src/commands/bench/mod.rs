@@ -6,6 +6,7 @@ pub mod convert;
 mod cpu_time;
 pub mod edit;
 pub mod io;
+pub mod layers;
 pub mod lookup;
 pub mod model;
 pub mod recover;
@@ -14,6 +15,7 @@ pub mod render_noise;
 pub mod render_set;
 pub mod serve;
 pub mod tabulate;
+mod torch;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -33,6 +35,9 @@ pub enum What {
     /// DeepBRDF training seconds per BRDF (cpu and paper presets) and decode seconds
     /// (target: decoding <= 0.15 s on 2 cores).
     Model(model::Args),
+    /// Table 1's layers one by one: forward, input gradient and weight gradient, seconds and
+    /// GFLOP/s beside one large matrix product's rate.
+    Layers(layers::Args),
     /// Converting RGL measurements (.bsdf) to the MERL grid (target: <= 10 s per file on 2
     /// cores).
     Convert(convert::Args),
@@ -60,6 +65,7 @@ pub fn run(args: Args, progress: &dyn Progress) -> anyhow::Result<()> {
         What::Lookup(a) => lookup::run(a, progress),
         What::Tabulate(a) => tabulate::run(a, progress),
         What::Model(a) => model::run(a, progress),
+        What::Layers(a) => layers::run(a, progress),
         What::Render(a) => render::run(a, progress),
         What::RenderNoise(a) => render_noise::run(a, progress),
         What::Convert(a) => convert::run(a, progress),

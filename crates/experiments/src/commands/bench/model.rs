@@ -18,9 +18,10 @@ pub struct Args {
     /// Latent dimension k.
     #[arg(long, default_value_t = 10)]
     pub k: usize,
-    /// BRDFs per training batch (default: each preset's own batch size).
-    #[arg(long)]
-    pub batch: Option<usize>,
+    /// BRDFs per training batch, one row each (comma-separated) [default: each preset's own
+    /// batch size].
+    #[arg(long, value_delimiter = ',')]
+    pub batch: Vec<usize>,
     /// Timed training steps per preset (after one warm-up step).
     #[arg(long, default_value_t = 3)]
     pub steps: usize,
@@ -39,6 +40,8 @@ pub struct Args {
     /// Also time the network of this training configuration (JSON, as `train` saves it).
     #[arg(long, value_name = "FILE")]
     pub config: Option<std::path::PathBuf>,
+    #[command(flatten)]
+    pub torch: super::torch::TorchArgs,
 }
 
 fn parse_preset(s: &str) -> Result<Preset, String> {
@@ -57,8 +60,20 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     );
     let mut per_sample = Vec::new();
     let mut slice_decode = None;
+    let mut table1 = Vec::new();
     for (name, config) in runs {
-        let batch = args.batch.unwrap_or(config.batch_size);
+        let batches =
+            if args.batch.is_empty() { vec![config.batch_size] } else { args.batch.clone() };
+        for &batch in &batches[..batches.len() - 1] {
+            let train =
+                timing::training_steps(&config.model, batch, config.threads, args.steps, &device)?;
+            let step = train.median();
+            println!("{:12} {:>6} {:>16.3} {:>16.4}", name, batch, step, step / batch as f64);
+            if config.model.slice_config().is_none() {
+                table1.push((name.clone(), batch, step / batch as f64));
+            }
+        }
+        let batch = batches[batches.len() - 1];
         let train =
             timing::training_steps(&config.model, batch, config.threads, args.steps, &device)?;
         let decode = timing::decode(&config.model, args.decodes, &device)?;
@@ -82,8 +97,12 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         if name == Preset::Slice.name() {
             slice_decode = Some(all.median());
         }
+        if config.model.slice_config().is_none() {
+            table1.push((name.clone(), batch, step / batch as f64));
+        }
         per_sample.push((name, step / batch as f64));
     }
+    super::torch::compare(&args.torch, &table1, args.steps)?;
     if let [(a, ta), (b, tb)] = &per_sample[..] {
         println!("training cost per sample: {b} / {a} = {:.1}x", tb / ta);
     }
