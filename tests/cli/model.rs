@@ -286,9 +286,35 @@ fn the_configurations_in_configs_load_and_differ_from_the_slice_preset_only_in_i
     use deepbrdf_model::TrainConfig;
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs");
     let mut seen = 0;
+    let (mut table1, mut paths) = (0, Vec::new());
     for entry in std::fs::read_dir(&dir).unwrap() {
         let path = entry.unwrap().path();
+        match path.is_dir() {
+            // configs/table1-schedules: the schedules issue 57 compared.
+            true => paths.extend(std::fs::read_dir(&path).unwrap().map(|e| e.unwrap().path())),
+            false => paths.push(path),
+        }
+    }
+    paths.sort();
+    for path in paths {
         let config = TrainConfig::from_file(&path).unwrap_or_else(|e| panic!("{path:?}: {e}"));
+        // Table 1's CPU schedules: the paper's layers, whatever the schedule.
+        if let deepbrdf_model::autoencoder::Architecture::Convolutional(c) =
+            &config.model.architecture
+        {
+            let paper = deepbrdf_model::autoencoder::AutoencoderConfig::paper(10);
+            let deepbrdf_model::autoencoder::Architecture::Convolutional(p) = &paper.architecture
+            else {
+                panic!("the paper preset is convolutional")
+            };
+            assert_eq!(
+                (c.projection, c.encoder_channels, c.residual_blocks, c.decoder_channels),
+                (p.projection, p.encoder_channels, p.residual_blocks, p.decoder_channels),
+                "{path:?}"
+            );
+            table1 += 1;
+            continue;
+        }
         let mut preset = TrainConfig::slice(config.model.latent);
         let slice = config.model.slice_config().expect("a slice configuration").clone();
         if let deepbrdf_model::autoencoder::Architecture::Slice(s) = &mut preset.model.architecture
@@ -300,6 +326,7 @@ fn the_configurations_in_configs_load_and_differ_from_the_slice_preset_only_in_i
         seen += 1;
     }
     assert!(seen >= 2, "configs/ holds the ablation configurations");
+    assert!(table1 >= 5, "configs/ holds Table 1's CPU schedules");
 }
 
 #[test]

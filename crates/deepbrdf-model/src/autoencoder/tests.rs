@@ -35,16 +35,17 @@ fn a_standardised_network_divides_its_input_and_multiplies_its_output_by_the_sca
     let unit = config.init_seeded(5, &device).unwrap().with_offset(&offset).unwrap();
     let scaled = unit.clone().with_scale(&vec![2.0; INPUT_VALUES]).unwrap();
     let latent = Tensor::<2>::from_data(TensorData::new(vec![0.3f32, -0.7], [1, 2]), &device);
-    let a: Vec<f32> = unit.decode_deviation(latent.clone()).into_data().to_vec().unwrap();
-    let b: Vec<f32> = scaled.decode_deviation(latent).into_data().to_vec().unwrap();
+    let a: Vec<f32> =
+        unit.decode_deviation(latent.clone()).into_data().try_to_vec::<f32>().unwrap();
+    let b: Vec<f32> = scaled.decode_deviation(latent).into_data().try_to_vec::<f32>().unwrap();
     assert!(a.iter().zip(&b).all(|(a, b)| (2.0 * a - b).abs() <= 1e-6 * a.abs().max(1.0)));
     let centred = Tensor::<4>::random(
         [1, INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE],
         burn::tensor::Distribution::Uniform(-1.0, 1.0),
         &device,
     );
-    let a: Vec<f32> = unit.encode_centred(centred.clone()).into_data().to_vec().unwrap();
-    let b: Vec<f32> = scaled.encode_centred(centred * 2.0).into_data().to_vec().unwrap();
+    let a: Vec<f32> = unit.encode_centred(centred.clone()).into_data().try_to_vec::<f32>().unwrap();
+    let b: Vec<f32> = scaled.encode_centred(centred * 2.0).into_data().try_to_vec::<f32>().unwrap();
     assert!(a.iter().zip(&b).all(|(a, b)| (a - b).abs() <= 1e-5 * a.abs().max(1.0)), "{a:?} {b:?}");
     // A scale needs a standardising configuration, positive values and the layout's length.
     let plain = narrow(2, 2, 0, true).init_seeded(5, &device).unwrap();

@@ -82,62 +82,33 @@ pub fn profile(
         _ => unreachable!("a convolutional configuration builds a convolutional network"),
     };
     let algorithm = network.conv;
-    let mut out = Vec::new();
-    let mut side = SIDE;
-    let mut channels = SLICE_CHANNELS;
+    // Each layer with its name, in the order a forward pass runs them; the input shape of
+    // each is the output shape of the one before (the linear layers see [batch, n, 1, 1]).
+    let mut layers: Vec<(String, Layer<'_>)> = Vec::new();
     for (i, conv) in network.down.iter().enumerate() {
-        let timing = time_layer(
-            format!("conv{}", i + 1),
-            Layer::Conv(conv),
-            algorithm,
-            [batch, channels, side, side],
-            repeats,
-            &device,
-        )?;
-        channels = timing.output[0];
-        side = timing.output[1];
-        out.push(timing);
+        layers.push((format!("conv{}", i + 1), Layer::Conv(conv)));
     }
     for (i, block) in network.residual.iter().enumerate() {
-        for (part, conv) in [("a", &block.conv1), ("b", &block.conv2)] {
-            let name = format!("res{}.{part}", i + 1);
-            let shape = [batch, channels, side, side];
-            out.push(time_layer(name, Layer::Conv(conv), algorithm, shape, repeats, &device)?);
-        }
+        layers.push((format!("res{}.a", i + 1), Layer::Conv(&block.conv1)));
+        layers.push((format!("res{}.b", i + 1), Layer::Conv(&block.conv2)));
     }
-    let bottleneck = channels * BOTTLENECK_SIDE * BOTTLENECK_SIDE;
-    let to_latent = Layer::Linear(&network.to_latent);
-    out.push(time_layer(
-        "fc_in".into(),
-        to_latent,
-        algorithm,
-        [batch, bottleneck, 1, 1],
-        repeats,
-        &device,
-    )?);
-    let latent = network.latent;
-    let from_latent = Layer::Linear(&network.from_latent);
-    out.push(time_layer(
-        "fc_out".into(),
-        from_latent,
-        algorithm,
-        [batch, latent, 1, 1],
-        repeats,
-        &device,
-    )?);
-    let mut side = BOTTLENECK_SIDE;
+    layers.push(("fc_in".into(), Layer::Linear(&network.to_latent)));
+    layers.push(("fc_out".into(), Layer::Linear(&network.from_latent)));
     for (i, deconv) in network.up.iter().enumerate() {
-        let shape = [batch, channels, side, side];
-        let timing = time_layer(
-            format!("deconv{}", i + 1),
-            Layer::Deconv(deconv),
-            algorithm,
-            shape,
-            repeats,
-            &device,
-        )?;
-        channels = timing.output[0];
-        side = timing.output[1];
+        layers.push((format!("deconv{}", i + 1), Layer::Deconv(deconv)));
+    }
+    let mut shape = [batch, SLICE_CHANNELS, SIDE, SIDE];
+    let mut out = Vec::new();
+    for (name, layer) in layers {
+        if matches!(layer, Layer::Linear(_)) {
+            shape = [batch, shape[1] * shape[2] * shape[3], 1, 1];
+        } else if shape[2] == 1 {
+            // After the fully connected layers: the bottleneck images again.
+            let channels = shape[1] / (BOTTLENECK_SIDE * BOTTLENECK_SIDE);
+            shape = [batch, channels, BOTTLENECK_SIDE, BOTTLENECK_SIDE];
+        }
+        let timing = time_layer(name, layer, algorithm, shape, repeats, &device)?;
+        shape = [batch, timing.output[0], timing.output[1], timing.output[2]];
         out.push(timing);
     }
     Ok(out)
@@ -269,4 +240,43 @@ pub fn matmul_gflops(n: usize, repeats: usize, device: &Device) -> Result<f64> {
     }
     runs.sort_by(f64::total_cmp);
     Ok(2.0 * (n as f64).powi(3) / runs[runs.len() / 2] / 1e9)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::autoencoder::ConvolutionalConfig;
+
+    #[test]
+    fn every_layer_is_profiled_with_its_shapes_and_work() {
+        let config = AutoencoderConfig::convolutional(
+            3,
+            ConvolutionalConfig::new()
+                .with_encoder_channels([2, 2, 2])
+                .with_residual_blocks(1)
+                .with_decoder_channels([2, 2]),
+        );
+        let layers = profile(&config, 1, 1, &Device::default()).unwrap();
+        let names: Vec<&str> = layers.iter().map(|l| l.name.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "conv1", "conv2", "conv3", "res1.a", "res1.b", "fc_in", "fc_out", "deconv1",
+                "deconv2", "deconv3"
+            ]
+        );
+        assert_eq!(
+            (layers[0].input.clone(), layers[0].output.clone()),
+            (vec![540, 90, 90], vec![2, 45, 45])
+        );
+        assert_eq!(layers[5].input, vec![2 * 144, 1, 1]);
+        assert_eq!(layers[7].input, vec![2, 12, 12]);
+        assert_eq!(layers[9].output, vec![540, 90, 90]);
+        // conv1: 2 x 45 x 45 outputs of 540 x 9 taps; deconv3: 540 x 90 x 90 outputs of 2 x 16 / 4.
+        assert_eq!(layers[0].macs, (2 * 45 * 45 * 540 * 9) as f64);
+        assert_eq!(layers[9].macs, (540 * 90 * 90 * 2 * 4) as f64);
+        assert!(layers.iter().all(|l| l.forward > 0.0 && l.total() >= l.forward));
+        let slice = AutoencoderConfig::slice(3);
+        assert!(profile(&slice, 1, 1, &Device::default()).is_err());
+    }
 }
