@@ -104,15 +104,10 @@ pub fn write_schedules(runs: &[ScheduleRun], out: &Path, note: &str) -> Result<(
 fn summary(runs: &[ScheduleRun], note: &str) -> String {
     let common = runs.iter().map(|r| r.log.len()).min().unwrap_or(0);
     let common_hours = runs.iter().map(ScheduleRun::seconds).fold(f64::INFINITY, f64::min) / 3600.0;
-    let epochs: Vec<usize> = [1, 5, 10, 20, 50, 100, common]
-        .into_iter()
-        .filter(|&e| e >= 1 && e <= common)
-        .fold(Vec::new(), |mut v, e| {
-            if !v.contains(&e) {
-                v.push(e);
-            }
-            v
-        });
+    let mut epochs: Vec<usize> =
+        [1, 5, 10, 20, 50, 100, common].into_iter().filter(|&e| e >= 1 && e <= common).collect();
+    epochs.sort_unstable();
+    epochs.dedup();
     let mut s = String::from("# Table 1 training schedules\n\n");
     let _ = writeln!(s, "{note}\n");
     let _ = write!(s, "| schedule | settings | epochs | hours | s / epoch |");

@@ -95,19 +95,7 @@ impl Autoencoder {
     /// Sets the fixed output offset (the per-value training mean, 540 x 90 x 90 in layout order).
     /// Errors if the configuration has no offset or `values` has the wrong length.
     pub fn with_offset(self, values: &[f32]) -> crate::error::Result<Self> {
-        if values.len() != INPUT_VALUES {
-            return Err(ModelError::Invalid(format!(
-                "an offset has {INPUT_VALUES} values, got {}",
-                values.len()
-            )));
-        }
-        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-            return Err(ModelError::Invalid(format!("offset value {i} is not finite")));
-        }
-        let data = TensorData::new(values.to_vec(), [INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE]);
-        let set = |old: Param<Tensor<3>>| {
-            old.map(|old| Tensor::from_data(data, &old.device())).set_require_grad(false)
-        };
+        check_layout("an offset", "offset", values, |v| v.is_finite(), "finite")?;
         match self {
             Self::Convolutional(mut c) => {
                 let Some(old) = c.offset.take() else {
@@ -115,7 +103,7 @@ impl Autoencoder {
                         "this configuration has no mean offset".into(),
                     ));
                 };
-                c.offset = Some(set(old));
+                c.offset = Some(fixed_layout(old, values));
                 Ok(Self::Convolutional(c))
             }
             Self::Slice(_) => {
@@ -128,16 +116,8 @@ impl Autoencoder {
     /// every value positive). Errors if the configuration does not standardise or `values` has
     /// the wrong length.
     pub fn with_scale(self, values: &[f32]) -> crate::error::Result<Self> {
-        if values.len() != INPUT_VALUES {
-            return Err(ModelError::Invalid(format!(
-                "a scale has {INPUT_VALUES} values, got {}",
-                values.len()
-            )));
-        }
-        if let Some(i) = values.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
-            return Err(ModelError::Invalid(format!("scale value {i} is not positive and finite")));
-        }
-        let data = TensorData::new(values.to_vec(), [INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE]);
+        let positive = |v: f32| v.is_finite() && v > 0.0;
+        check_layout("a scale", "scale", values, positive, "positive and finite")?;
         match self {
             Self::Convolutional(mut c) => {
                 let Some(old) = c.scale.take() else {
@@ -145,9 +125,7 @@ impl Autoencoder {
                         "this configuration does not standardise per value".into(),
                     ));
                 };
-                c.scale = Some(
-                    old.map(|old| Tensor::from_data(data, &old.device())).set_require_grad(false),
-                );
+                c.scale = Some(fixed_layout(old, values));
                 Ok(Self::Convolutional(c))
             }
             Self::Slice(_) => {
@@ -252,6 +230,34 @@ impl Autoencoder {
         let latent = self.encode(input, mask); // [batch, k]
         self.decode(latent) // [batch, 540, 90, 90]
     }
+}
+
+/// Errors unless `values` is one value per layout cell and `ok` holds for each (`a_what` and
+/// `what` name it in the message, `needs` says what `ok` asks).
+fn check_layout(
+    a_what: &str,
+    what: &str,
+    values: &[f32],
+    ok: impl Fn(f32) -> bool,
+    needs: &str,
+) -> crate::error::Result<()> {
+    if values.len() != INPUT_VALUES {
+        return Err(ModelError::Invalid(format!(
+            "{a_what} has {INPUT_VALUES} values, got {}",
+            values.len()
+        )));
+    }
+    match values.iter().position(|&v| !ok(v)) {
+        Some(i) => Err(ModelError::Invalid(format!("{what} value {i} is not {needs}"))),
+        None => Ok(()),
+    }
+}
+
+/// `values` (540 x 90 x 90, layout order) in place of the fixed, untrained layout `old`, on its
+/// device.
+fn fixed_layout(old: Param<Tensor<3>>, values: &[f32]) -> Param<Tensor<3>> {
+    let data = TensorData::new(values.to_vec(), [INPUT_CHANNELS, INPUT_SIDE, INPUT_SIDE]);
+    old.map(|old| Tensor::from_data(data, &old.device())).set_require_grad(false)
 }
 
 #[cfg(test)]

@@ -10,8 +10,6 @@
 //! only the layer's parameters tracked; a gradient's time is the difference from the forward
 //! pass's.
 
-use std::time::Instant;
-
 use burn::module::Module;
 use burn::nn::conv::{Conv2d, ConvTranspose2d};
 use burn::nn::Linear;
@@ -188,29 +186,24 @@ fn time_layer(
     let probe = untracked.layer().forward(algorithm, x.clone());
     let output = probe.dims();
     let g = Tensor::<4>::random(output, Distribution::Uniform(-1.0, 1.0), device);
-    // Every run: forward, the product with g, its sum read back; `tracked` picks what the
-    // backward pass (if any) differentiates.
+    // Every run: forward, the product with g, its sum read back or differentiated (what the
+    // backward pass differentiates: the input if tracked, the layer's parameters if tracked).
     let run = |layer: &Layer<'_>, track_input: bool, backward: bool| -> Result<f64> {
-        let x = if track_input { x.clone().require_grad() } else { x.clone() };
-        let start = Instant::now();
-        let loss = (layer.forward(algorithm, x) * g.clone()).sum();
-        if backward {
-            std::hint::black_box(loss.backward());
-        } else {
-            std::hint::black_box(loss.into_scalar::<f32>());
-        }
-        device.sync().map_err(|e| ModelError::Invalid(format!("device error: {e:?}")))?;
-        Ok(start.elapsed().as_secs_f64())
+        let timing = crate::timing::timed(repeats, || {
+            let x = if track_input { x.clone().require_grad() } else { x.clone() };
+            let loss = (layer.forward(algorithm, x) * g.clone()).sum();
+            if backward {
+                std::hint::black_box(loss.backward());
+            } else {
+                std::hint::black_box(loss.into_scalar::<f32>());
+            }
+            device.sync().map_err(|e| ModelError::Invalid(format!("device error: {e:?}")))
+        })?;
+        Ok(timing.median())
     };
-    let median = |f: &dyn Fn() -> Result<f64>| -> Result<f64> {
-        f()?;
-        let mut runs = (0..repeats.max(1)).map(|_| f()).collect::<Result<Vec<f64>>>()?;
-        runs.sort_by(f64::total_cmp);
-        Ok(runs[runs.len() / 2])
-    };
-    let forward = median(&|| run(&untracked.layer(), false, false))?;
-    let with_input = median(&|| run(&untracked.layer(), true, true))?;
-    let with_weight = median(&|| run(&layer, false, true))?;
+    let forward = run(&untracked.layer(), false, false)?;
+    let with_input = run(&untracked.layer(), true, true)?;
+    let with_weight = run(&layer, false, true)?;
     Ok(LayerTiming {
         name,
         input: shape[1..].to_vec(),
@@ -228,18 +221,12 @@ pub fn matmul_gflops(n: usize, repeats: usize, device: &Device) -> Result<f64> {
     let device = device.clone().without_autodiff();
     let a = Tensor::<2>::random([n, n], Distribution::Uniform(-1.0, 1.0), &device);
     let b = Tensor::<2>::random([n, n], Distribution::Uniform(-1.0, 1.0), &device);
-    let mut runs = Vec::new();
-    for i in 0..=repeats.max(1) {
-        let start = Instant::now();
+    let timing = crate::timing::timed(repeats, || {
         let c = a.clone().matmul(b.clone());
         std::hint::black_box(c.slice([0..1, 0..1]).into_scalar::<f32>());
-        device.sync().map_err(|e| ModelError::Invalid(format!("device error: {e:?}")))?;
-        if i > 0 {
-            runs.push(start.elapsed().as_secs_f64());
-        }
-    }
-    runs.sort_by(f64::total_cmp);
-    Ok(2.0 * (n as f64).powi(3) / runs[runs.len() / 2] / 1e9)
+        device.sync().map_err(|e| ModelError::Invalid(format!("device error: {e:?}")))
+    })?;
+    Ok(2.0 * (n as f64).powi(3) / timing.median() / 1e9)
 }
 
 #[cfg(test)]

@@ -64,30 +64,32 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
     for (name, config) in runs {
         let batches =
             if args.batch.is_empty() { vec![config.batch_size] } else { args.batch.clone() };
-        for &batch in &batches[..batches.len() - 1] {
-            let train =
-                timing::training_steps(&config.model, batch, config.threads, args.steps, &device)?;
-            let step = train.median();
-            println!("{:12} {:>6} {:>16.3} {:>16.4}", name, batch, step, step / batch as f64);
+        let steps = batches
+            .iter()
+            .map(|&batch| {
+                let train = timing::training_steps(
+                    &config.model,
+                    batch,
+                    config.threads,
+                    args.steps,
+                    &device,
+                )?;
+                Ok((batch, train.median()))
+            })
+            .collect::<anyhow::Result<Vec<(usize, f64)>>>()?;
+        let decode = timing::decode(&config.model, args.decodes, &device)?;
+        let (net, all) = (&decode.network, &decode.whole);
+        for (i, &(batch, step)) in steps.iter().enumerate() {
+            print!("{:12} {:>6} {:>16.3} {:>16.4}", name, batch, step, step / batch as f64);
+            match i + 1 == steps.len() {
+                true => println!(" {:>14.4} {:>14.4}", net.median(), all.median()),
+                false => println!(),
+            }
             if config.model.slice_config().is_none() {
                 table1.push((name.clone(), batch, step / batch as f64));
             }
         }
-        let batch = batches[batches.len() - 1];
-        let train =
-            timing::training_steps(&config.model, batch, config.threads, args.steps, &device)?;
-        let decode = timing::decode(&config.model, args.decodes, &device)?;
-        let (net, all) = (&decode.network, &decode.whole);
-        let step = train.median();
-        println!(
-            "{:12} {:>6} {:>16.3} {:>16.4} {:>14.4} {:>14.4}",
-            name,
-            batch,
-            step,
-            step / batch as f64,
-            net.median(),
-            all.median()
-        );
+        let (batch, step) = steps[steps.len() - 1];
         let (deep, linear) = (all.median(), ipca.median());
         let ratio = deep / linear;
         println!(
@@ -96,9 +98,6 @@ pub fn run(args: Args, _progress: &dyn Progress) -> anyhow::Result<()> {
         );
         if name == Preset::Slice.name() {
             slice_decode = Some(all.median());
-        }
-        if config.model.slice_config().is_none() {
-            table1.push((name.clone(), batch, step / batch as f64));
         }
         per_sample.push((name, step / batch as f64));
     }
